@@ -1,0 +1,37 @@
+# Two set-up commands for a fresh machine (each installs what it needs):
+#   make demo   a demo pipeline on the embedded sample files
+#   make test   the test suite
+PYTHON ?= python3
+VENV ?= .venv
+BIN = $(VENV)/bin
+DEMO = build/demo
+
+.PHONY: demo test bench clean
+
+$(BIN)/.installed: setup.cfg pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+	$(BIN)/python -m pip install --quiet -e '.[test]'
+	touch $@
+
+demo: $(BIN)/.installed
+	@mkdir -p $(DEMO)
+	@echo '$$ rough info sample_profiles/rock-profile.tsv'
+	@$(BIN)/rough info sample_profiles/rock-profile.tsv
+	@echo
+	@echo '$$ rough convert sample_profiles/rock-profile.tsv -o $(DEMO)/rock-profile.x3p'
+	@$(BIN)/rough convert sample_profiles/rock-profile.tsv -o $(DEMO)/rock-profile.x3p
+	@echo '$$ cat $(DEMO)/rock-profile.x3p | rough convert -f gsf | rough info'
+	@cat $(DEMO)/rock-profile.x3p | $(BIN)/rough convert -f gsf | $(BIN)/rough info
+	@echo
+	@echo '$$ rough info --json sample_profiles/rock-map.x3p   (selected keys)'
+	@$(BIN)/rough info --json sample_profiles/rock-map.x3p | $(BIN)/python -c "import json,sys; d=json.load(sys.stdin); print({k: d[k] for k in ('shape', 'spacing', 'valid_points', 'Sq')})"
+
+test: $(BIN)/.installed
+	$(BIN)/python -m pytest -q
+
+bench: $(BIN)/.installed
+	$(BIN)/python bench/bench_io.py
+
+clean:
+	rm -rf build $(VENV) *.egg-info .pytest_cache .hypothesis

@@ -1,0 +1,67 @@
+"""rough info: what a surface file holds."""
+
+import json
+
+import click
+
+from .options import report_format, surface_input
+from .report import emit
+
+
+@click.command(short_help="Shape, spacing, size, valid points, z range, Rq/Sq and history.")
+@surface_input
+@report_format
+def info(surface, input, as_json, as_tsv):
+    """Describe the surface in INPUT (default: standard input).
+
+    Reports the number of points and spacing (x first), the physical size, the
+    valid (non-NaN) points, the height range and the RMS height (Rq for a profile,
+    Sq for a map) of the valid points about their mean, with no levelling; then the
+    file's metadata and history.
+
+    \b
+    Examples:
+        rough info scan.x3p
+        rough synth --length 20mm | rough info
+        rough info --json scan.x3p | jq .spacing
+    """
+    from ..io import describe
+    from ..summary import summary
+    from ..units import format_length
+
+    facts = summary(surface)
+    document = {"file": input, "format": surface.source_format, **facts}
+    x_by_y = " × ".join
+    rms_key = "Rq" if surface.is_profile else "Sq"
+    rows = [
+        ("file", input, "", "standard input" if input == "-" else input),
+        ("format", surface.source_format, "", describe(surface.source_format)),
+        ("kind", facts["kind"], "", facts["kind"]),
+        ("shape", facts["shape"], "points", f"{x_by_y(map(str, facts['shape']))} points" + ("" if surface.is_profile else " (x × y)")),
+        ("spacing", facts["spacing"], "m", x_by_y(format_length(d) for d in facts["spacing"])),
+        ("size", facts["size"], "m", x_by_y(format_length(s) for s in facts["size"])),
+        ("origin", facts["origin"], "m", ", ".join(format_length(o) for o in facts["origin"])),
+        ("valid_points", facts["valid_points"], "points",
+         f"{facts['valid_points']} of {facts['points']} ({100 * facts['valid_points'] / facts['points']:.2f} %)"),
+        ("z_min", facts["z_min"], "m", _length(facts["z_min"])),
+        ("z_max", facts["z_max"], "m", _length(facts["z_max"])),
+        (rms_key, facts[rms_key], "m", f"{_length(facts[rms_key])} (valid points about their mean, not levelled)"),
+        ("units_in_file", f"{surface.units.xy} {surface.units.z}", "", f"xy {surface.units.xy}, z {surface.units.z}"),
+    ]
+    rows += [(f"metadata.{key}", value, "", value) for key, value in sorted(facts["metadata"].items())]
+    rows += [
+        (f"history.{number}", json.dumps(entry, ensure_ascii=False), "", _history_line(entry))
+        for number, entry in enumerate(facts["history"], 1)
+    ]
+    emit(rows, document, as_json, as_tsv)
+
+
+def _length(value):
+    from ..units import format_length
+
+    return "none (no valid points)" if value is None else format_length(value)
+
+
+def _history_line(entry):
+    parameters = " ".join(f"{key}={value}" for key, value in entry.get("parameters", {}).items())
+    return f"{entry.get('time', '?')}  rough {entry.get('version', '?')} {entry.get('command', '?')} {parameters}".rstrip()

@@ -1,0 +1,153 @@
+"""The ``rough`` command: a click group with one small module per subcommand.
+
+Subcommand modules are imported only when needed, and they import the library only
+inside their functions, so ``rough --help`` starts without numpy. Errors end in one
+line on stderr (``rough COMMAND: FILE: problem``) and an exit status: 0 success, 2 bad
+usage or bad input, 1 any other failure, 130 interrupted; a closed downstream pipe
+ends the command quietly (141, as a SIGPIPE death would).
+"""
+
+import importlib
+import logging
+import os
+import sys
+
+import click
+
+from .. import __version__
+
+COMMANDS = {
+    "info": "rough.cli.info:info",
+    "convert": "rough.cli.convert:convert",
+}
+
+log = logging.getLogger("rough")
+_invoked = []
+
+
+class PipeClosed(Exception):
+    """The reader of standard output went away (raised instead of BrokenPipeError,
+    which click would turn into exit status 1)."""
+
+
+class LazyGroup(click.Group):
+    """A group whose subcommands are imported on first use."""
+
+    def invoke(self, ctx):
+        try:
+            return super().invoke(ctx)
+        except BrokenPipeError as error:
+            raise PipeClosed() from error
+
+    def list_commands(self, ctx):
+        return sorted(COMMANDS)
+
+    def get_command(self, ctx, name):
+        if name not in COMMANDS:
+            return None
+        module, attribute = COMMANDS[name].split(":")
+        _invoked.append(name)
+        return getattr(importlib.import_module(module), attribute)
+
+
+@click.group(cls=LazyGroup, context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(__version__, "--version", prog_name="rough", message="%(prog)s %(version)s")
+@click.option("-q", "--quiet", is_flag=True, help="Print errors only, no warnings or notes.")
+@click.option("-v", "--verbose", count=True, help="Print notes on what is done (-vv: more).")
+@click.option("--debug", is_flag=True, help="Show a traceback with every error.")
+def cli(quiet, verbose, debug):
+    """Surface metrology for rock, worn and machined surfaces.
+
+    Every command reads a profile or height map from a file or standard input and
+    writes to a file or standard output, so commands chain in pipes:
+
+    \b
+        rough convert scan.csv -o scan.x3p
+        cat scan.x3p | rough info
+        rough info --json scan.x3p | jq .valid_points
+
+    Lengths take a unit (0.1545mm, 30.9um, 2e-3m); a bare number is in mm.
+    Invalid points are NaN throughout.
+    """
+    level = logging.ERROR if quiet else (logging.WARNING, logging.INFO, logging.DEBUG)[min(verbose, 2)]
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(_Formatter())
+    log.handlers[:] = [handler]
+    log.setLevel(level)
+    log.propagate = False
+
+
+class _Formatter(logging.Formatter):
+    def format(self, record):
+        kind = "warning: " if record.levelno >= logging.WARNING else ""
+        return f"{_prefix()}: {kind}{record.getMessage()}"
+
+
+def _prefix():
+    return f"rough {_invoked[-1]}" if _invoked else "rough"
+
+
+def main(args=None):
+    """Entry point: run the command line and exit with its status."""
+    args = sys.argv[1:] if args is None else list(args)
+    sys.exit(run(args))
+
+
+def run(args):
+    """Run the command line with ``args``; return the exit status."""
+    from ..errors import RoughError
+
+    debug = "--debug" in args
+    try:
+        result = cli.main(args=args, prog_name="rough", standalone_mode=False)
+        return result if isinstance(result, int) else 0
+    except click.exceptions.Exit as done:
+        return done.exit_code
+    except click.UsageError as error:
+        command = f" {_invoked[-1]}" if _invoked else ""
+        _say(f"{error.format_message()} (see 'rough{command} --help')")
+        return 2
+    except click.ClickException as error:
+        _say(error.format_message())
+        return error.exit_code
+    except (click.Abort, KeyboardInterrupt):
+        _say("interrupted")
+        return 130
+    except (PipeClosed, BrokenPipeError):
+        _silence_stdout()
+        return 141
+    except RoughError as error:
+        _report(error, debug)
+        return error.exit_code
+    except OSError as error:
+        where = f"{error.filename}: " if error.filename else ""
+        _report(error, debug, f"{where}{error.strerror or error}")
+        return 1
+    except Exception as error:  # the last resort: say what failed, in one line
+        _report(error, debug, f"internal error: {type(error).__name__}: {error} (run with --debug for details)")
+        return 1
+
+
+def _report(error, debug, message=None):
+    if debug:
+        import traceback
+
+        traceback.print_exception(error, file=sys.stderr)
+    _say(message or str(error))
+
+
+def _say(message):
+    try:
+        print(f"{_prefix()}: {message}", file=sys.stderr, flush=True)
+    except (OSError, ValueError):
+        pass
+
+
+def _silence_stdout():
+    """After EPIPE, point stdout at /dev/null so that the interpreter's final flush
+    does not print a second error."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):
+        pass

@@ -1,0 +1,125 @@
+"""Options shared by the subcommands, as decorators (in the manner of rasterio's rio).
+
+``surface_input`` adds INPUT (default ``-``) and the read options and hands the
+command a :class:`~rough.Surface`; ``surface_output`` adds ``-o/--output`` and
+``-f/--format`` and hands it an :class:`Output` that writes a surface there; ``report_format``
+adds ``--json``/``--tsv``. Lengths take a unit; a bare number is in mm.
+"""
+
+import dataclasses
+import functools
+import sys
+
+import click
+
+FORMAT_CHOICES = ("x3p", "exr", "gsf", "tsv", "npy")
+
+
+class LengthType(click.ParamType):
+    """A length with a unit (``0.1545mm``, ``30.9um``, ``2e-3m``) → metres."""
+
+    name = "LENGTH"
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, float):
+            return value
+        from ..errors import InputError
+        from ..units import parse_length
+
+        try:
+            return parse_length(value)
+        except InputError as error:
+            self.fail(str(error), param, ctx)
+
+
+class SpacingType(LengthType):
+    """``DX`` or ``DX,DY`` → a tuple of metres."""
+
+    name = "DX[,DY]"
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, tuple):
+            return value
+        parts = [super(SpacingType, self).convert(part, param, ctx) for part in str(value).split(",")]
+        if len(parts) > 2 or min(parts) <= 0:
+            self.fail(f"{value!r}: give one or two positive lengths, e.g. 1um or 1um,2um", param, ctx)
+        return tuple(parts)
+
+
+SPACING = SpacingType()
+
+
+def surface_input(command):
+    """INPUT plus ``--spacing``, ``--unit`` and ``--ignore-checksums``; the command
+    receives ``surface`` (the surface read) and ``input`` (the name given)."""
+
+    @functools.wraps(command)
+    def wrapper(*args, input, spacing, unit, ignore_checksums, **kwargs):
+        from ..io import read
+
+        surface = read(input, spacing=spacing, unit=unit, verify=not ignore_checksums)
+        return command(*args, surface=surface, input=input, **kwargs)
+
+    decorators = [
+        click.argument("input", default="-", metavar="[INPUT]"),
+        click.option("--spacing", type=SPACING, help="Spacing of data that carry none (NPY, a column of heights), e.g. 1um or 1um,2um; overrides a file's own."),
+        click.option("--unit", metavar="UNIT", help="Length unit of text values that name none (default m)."),
+        click.option("--ignore-checksums", is_flag=True, help="Read X3P files whose MD5 checksums fail, with a warning."),
+    ]
+    for decorator in reversed(decorators):
+        wrapper = decorator(wrapper)
+    return wrapper
+
+
+def surface_output(command):
+    """``-o/--output`` (default ``-``) and ``-f/--format``; the command receives
+    ``output``, an :class:`Output`."""
+
+    @functools.wraps(command)
+    def wrapper(*args, output, format, **kwargs):
+        return command(*args, output=Output(output, format), **kwargs)
+
+    wrapper = click.option(
+        "-f", "--format", type=click.Choice(FORMAT_CHOICES), default=None,
+        help="Output format (default: from the output file's extension; X3P on standard output).",
+    )(wrapper)
+    wrapper = click.option(
+        "-o", "--output", default="-", metavar="FILE", show_default=True,
+        help="Output file, written atomically; - is standard output.",
+    )(wrapper)
+    return wrapper
+
+
+@dataclasses.dataclass(frozen=True)
+class Output:
+    """Where a command's surface goes: a file (written atomically) or standard output
+    (X3P unless told otherwise; binary output to a terminal is refused)."""
+
+    path: str = "-"
+    requested_format: str = None
+
+    @property
+    def format(self):
+        from ..io import format_for_path
+
+        if self.requested_format:
+            return self.requested_format
+        return "x3p" if self.path == "-" else format_for_path(self.path)
+
+    def write(self, surface):
+        from ..errors import InputError
+        from ..io import BINARY, write
+
+        if self.path != "-":
+            write(surface, self.path, format=self.format)
+            return
+        if self.format in BINARY and sys.stdout.isatty():
+            raise InputError(f"refusing to write binary {self.format.upper()} to a terminal: use -o FILE, a pipe, or -f tsv")
+        write(surface, sys.stdout.buffer, format=self.format)
+        sys.stdout.buffer.flush()
+
+
+def report_format(command):
+    """``--json`` (one JSON object, SI units) and ``--tsv`` (key, value, unit rows)."""
+    command = click.option("--tsv", "as_tsv", is_flag=True, help="Print tab-separated rows: key, value, unit.")(command)
+    return click.option("--json", "as_json", is_flag=True, help="Print one JSON object (SI units).")(command)

@@ -1,0 +1,103 @@
+"""OpenEXR height maps, read and written with the OpenEXR 3 Python API.
+
+Written as Gwyddion writes them, so that Gwyddion builds with OpenEXR open the file
+at its true size: one float32 channel ``Y`` (ZIP compression, lossless), the double
+attributes ``Gwy::XReal``, ``Gwy::YReal``, ``Gwy::XOffset``, ``Gwy::YOffset`` and the
+string attributes ``Gwy::XYUnit``, ``Gwy::ZUnit``, ``Gwy::Title``. rough's units,
+metadata and history go in the string attributes ``rough:units``, ``rough:metadata``
+and ``rough:history`` (JSON). A one-row image is a profile.
+
+Read: a single height channel, ``Y``, ``Z`` or ``R`` (in that order of preference, or
+the only channel there is), in half, float or uint pixels. Without ``Gwy::XReal`` the
+spacing must come from ``--spacing``. Heights are float32, so a round trip keeps
+them to float32 rounding.
+"""
+
+import io
+
+import numpy as np
+
+from . import provenance
+from ..errors import FormatError
+from ..surface import Surface, Units
+
+HEIGHT_CHANNELS = ("Y", "Z", "R")
+MAX_POINTS = 1 << 31
+MAX_EXPANSION = 1100  # more than zlib's largest compression ratio (about 1032:1)
+
+
+def read(data, options):
+    import OpenEXR
+
+    header = _open(OpenEXR, data, header_only=True).header()
+    low, high = header["dataWindow"]
+    nx, ny = int(high[0] - low[0] + 1), int(high[1] - low[1] + 1)
+    if nx < 1 or ny < 1 or nx * ny > MAX_POINTS or nx * ny * 2 > MAX_EXPANSION * len(data):
+        raise FormatError(f"EXR data window of {nx}×{ny} pixels is impossible for a file of {len(data)} bytes")
+    channels = _open(OpenEXR, data).channels()
+    name = next((c for c in HEIGHT_CHANNELS if c in channels), None)
+    if name is None and len(channels) == 1:
+        name = next(iter(channels))
+    if name is None:
+        raise FormatError(f"EXR has channels {', '.join(sorted(channels))}; rough reads one height channel (Y, Z or R)")
+    heights = np.asarray(channels[name].pixels, dtype=np.float64)
+    if heights.shape != (ny, nx):
+        raise FormatError(f"EXR channel {name} has shape {heights.shape}, expected {(ny, nx)}")
+    if "Gwy::XReal" in header:
+        spacing = (_double(header, "Gwy::XReal") / nx, _double(header, "Gwy::YReal", _double(header, "Gwy::XReal") / nx * ny) / ny)
+    elif options.spacing is not None:
+        spacing = options.spacing
+    else:
+        raise FormatError("EXR file has no Gwy::XReal attribute, so no spacing; give it with --spacing")
+    origin = (_double(header, "Gwy::XOffset", 0.0), _double(header, "Gwy::YOffset", 0.0))
+    metadata = {"title": header["Gwy::Title"]} if header.get("Gwy::Title") else {}
+    units = Units(header.get("Gwy::XYUnit", "m"), header.get("Gwy::ZUnit", "m"))
+    metadata, units, history = provenance.restore(
+        {part: header.get(f"rough:{part}") for part in provenance.PARTS}, metadata, units
+    )
+    if ny == 1:
+        return Surface(heights[0], spacing[:1], origin[:1], units, metadata, history)
+    return Surface(heights, spacing, origin, units, metadata, history)
+
+
+def write(surface, stream):
+    import OpenEXR
+
+    heights = np.ascontiguousarray(np.atleast_2d(surface.heights), dtype=np.float32)
+    ny, nx = heights.shape
+    dy = surface.spacing[-1]
+    y0 = surface.origin[1] if len(surface.origin) == 2 else 0.0
+    header = {
+        "compression": OpenEXR.ZIP_COMPRESSION,
+        "type": OpenEXR.scanlineimage,
+        "Gwy::XReal": np.array([nx * surface.spacing[0]]),
+        "Gwy::YReal": np.array([ny * dy]),
+        "Gwy::XOffset": np.array([surface.origin[0]]),
+        "Gwy::YOffset": np.array([y0]),
+        "Gwy::XYUnit": "m",
+        "Gwy::ZUnit": "m",
+        **{f"rough:{part}": text for part, text in provenance.record(surface).items()},
+    }
+    if surface.metadata.get("title"):
+        header["Gwy::Title"] = str(surface.metadata["title"])
+    buffer = io.BytesIO()
+    OpenEXR.File(header, {"Y": heights}).write(buffer)
+    stream.write(buffer.getbuffer())
+
+
+def _open(OpenEXR, data, header_only=False):
+    try:
+        return OpenEXR.File(io.BytesIO(bytes(data)), separate_channels=True, header_only=header_only)
+    except Exception as error:  # the bindings raise plain RuntimeError/Exception for bad files
+        raise FormatError(f"not a readable OpenEXR file ({error})") from None
+
+
+def _double(header, key, default=None):
+    value = header.get(key, default)
+    if value is None:
+        raise FormatError(f"EXR attribute {key} is missing")
+    value = float(np.ravel(value)[0])
+    if not np.isfinite(value) or (key.endswith("Real") and value <= 0):
+        raise FormatError(f"EXR attribute {key} is not a usable length: {value}")
+    return value
+

@@ -1,0 +1,401 @@
+"""Text surfaces: read in several dialects, written as TSV.
+
+Read (the dialect is recognised from the content):
+    columns     ``z`` alone (needs ``--spacing``), ``x z``, ``x z valid`` or ``x y z``
+                (an x y z grid, points in any order, missing points NaN), separated by
+                spaces, tabs, commas or semicolons (then a decimal comma is accepted);
+                an optional line of column names, whose units (``x[um]``, ``z (nm)``,
+                ``Lateral um``) or a following line of units (``[mm];[mm];[1/0]``) say
+                the unit; a ``# unit: mm`` line gives it for all columns. Four or more
+                columns are a plain matrix of heights (rows are y; needs ``--spacing``).
+    Dektak      the Bruker Dektak CSV export (``Scan Parameters`` … ``Scan Data``).
+    Gwyddion    Gwyddion's text export (``# Width:``, ``# Height:``, ``# Value units:``).
+    key=value   a matrix after ``h=… w=…``, ``pixel size=…``, ``height conversion factor``.
+Units: named in the file, else ``unit`` (``--unit``), else metres. x values must be
+evenly spaced to within their printed precision (Dektak prints 0.1 µm steps for a
+0.15625 µm spacing); the spacing is their least-squares slope. Unevenly spaced x is
+refused rather than silently resampled. ``nan`` and ``BAD`` mark invalid points.
+
+Written (TSV): ``#`` lines with the unit, spacing, origin, units, metadata and one line
+per history entry, then ``x z`` (profiles) or ``x y z`` (maps, a blank line between
+rows, as gnuplot expects), in metres, with every float printed to round-trip exactly.
+"""
+
+import io
+import json
+import re
+
+import numpy as np
+
+from . import provenance
+from .. import __version__
+from ..errors import FormatError, InputError
+from ..surface import Surface, Units
+from ..units import metres_per
+
+_UNIT_IN_NAME = re.compile(r"[\[(]\s*([^\])]+?)\s*[\])]|\s([A-Za-zµμÅ]+)\s*$")
+_NUMERIC = re.compile(r"^[\s,;]*[+-]?(\d|\.\d|nan|inf|bad)", re.IGNORECASE)
+_BAD = re.compile(r"\bBAD\b", re.IGNORECASE)
+
+
+def read(data, options):
+    lines = [line for line in _decode(data).splitlines() if line.strip()]
+    if not lines:
+        raise FormatError("empty text file, no surface to read")
+    if any(line.strip() == "Scan Data" for line in lines[:200]):
+        return _dektak(lines, options)
+    if any(line.startswith("# Width:") for line in lines[:20]):
+        return _gwyddion_export(lines)
+    if "=" in lines[0] and not _NUMERIC.match(lines[0]):
+        return _key_value_matrix(lines, options)
+    return _columns(lines, options)
+
+
+def write(surface, stream):
+    stream.write(header_lines(surface).encode("utf-8"))
+    x = surface.origin[0] + surface.spacing[0] * np.arange(surface.points[0])
+    if surface.is_profile:
+        stream.write(b"x\tz\n")
+        _write_rows(stream, [x], surface.heights)
+        return
+    stream.write(b"x\ty\tz\n")
+    for row, heights in enumerate(surface.heights):
+        y = surface.origin[1] + surface.spacing[1] * row
+        _write_rows(stream, [x, np.full_like(x, y)], heights)
+        stream.write(b"\n")
+
+
+def header_lines(surface):
+    """The ``#`` lines that open rough's TSV output."""
+    parts = provenance.parts(surface)
+    lines = [
+        f"rough {__version__} {surface.kind}: positions and heights in metres",
+        "unit: m",
+        "spacing: " + " ".join(repr(d) for d in surface.spacing),
+        "origin: " + " ".join(repr(o) for o in surface.origin),
+        "units: " + json.dumps(parts["units"]),
+        "metadata: " + json.dumps(parts["metadata"]),
+        *("history: " + json.dumps(entry) for entry in parts["history"]),
+    ]
+    return "".join(f"# {line}\n" for line in lines)
+
+
+def _write_rows(stream, columns, heights):
+    for start in range(0, len(heights), 65536):
+        chunk = [c[start: start + 65536] for c in (*columns, heights)]
+        rows = ("\t".join(map(repr, values)) for values in zip(*(c.tolist() for c in chunk)))
+        stream.write(("\n".join(rows) + "\n").encode("ascii"))
+
+
+# -- dialects ------------------------------------------------------------------------
+
+
+def _columns(lines, options):
+    comments = [line.lstrip("#%").strip() for line in lines if line.lstrip().startswith(("#", "%"))]
+    settings = _comment_settings(comments)
+    body = [line for line in lines if not line.lstrip().startswith(("#", "%"))]
+    names, units_row, body = _column_names(body)
+    if not body:
+        raise FormatError("no numeric data found")
+    delimiter = _delimiter(body[0])
+    table = _numbers(body, delimiter, None)
+    count = table.shape[1]
+    default_unit = settings.get("unit") or options.unit or "m"
+    units = [_unit_of(name, default_unit) for name in (units_row or names or [""] * count)]
+    units += [default_unit] * (count - len(units))
+    lower = [n.strip().lower() for n in names]
+    if count >= 3 and any("valid" in n or "mask" in n for n in lower):
+        flag = next(i for i, n in enumerate(lower) if "valid" in n or "mask" in n)
+        keep = [i for i in range(count) if i != flag][:2]
+        heights = np.where(table[:, flag] != 0, table[:, keep[1]], np.nan)
+        return _profile(table[:, keep[0]], heights, units[keep[0]], units[keep[1]], settings, body, delimiter)
+    if count == 1:
+        return _from_spacing(table[:, 0] * metres_per(units[0]), options, settings, Units(units[0], units[0]))
+    if count == 2:
+        return _profile(table[:, 0], table[:, 1], units[0], units[1], settings, body, delimiter)
+    if count == 3:
+        return _grid(table, units, settings, body, delimiter)
+    heights = table * metres_per(default_unit)
+    return _from_spacing(heights if len(heights) > 1 else heights[0], options, settings, Units(default_unit, default_unit))
+
+
+def _dektak(lines, options):
+    start = next(i for i, line in enumerate(lines) if line.strip() == "Scan Data")
+    parameters = {}
+    for line in lines[:start]:
+        key, comma, value = line.partition(",")
+        if comma and value.strip():
+            parameters[key.strip()] = value.strip().rstrip(",")
+    names = [name.strip() for name in lines[start + 1].split(",")]
+    if len(names) < 2:
+        raise FormatError("Dektak CSV: no column names after 'Scan Data'")
+    body = lines[start + 2:]
+    table = _numbers(body, ",", (0, 1))
+    x_unit, z_unit = _unit_of(names[0], "um"), _unit_of(names[1], "um")
+    metadata = {"instrument": "Dektak stylus profiler"}
+    for key in ("Stylus", "Length", "Resolution", "Force", "Scan Type", "Profile", "Duration"):
+        if key in parameters:
+            metadata[f"dektak_{key.lower().replace(' ', '_')}"] = parameters[key]
+    surface = _profile(table[:, 0], table[:, 1], x_unit, z_unit, {}, body, ",")
+    surface.metadata.update(metadata)
+    return surface
+
+
+def _gwyddion_export(lines):
+    header = {}
+    for line in lines:
+        if line.startswith("#"):
+            key, colon, value = line[1:].partition(":")
+            if colon:
+                header[key.strip().lower()] = value.strip()
+    body = [line for line in lines if not line.startswith("#")]
+    table = _numbers(body, None, None)
+    z_unit = header.get("value units", "m")
+    try:
+        z_factor = metres_per(z_unit)
+    except InputError:
+        raise FormatError(f"Gwyddion export values are in {z_unit!r}, not a length") from None
+    width, xy_unit = _length_with_unit(header.get("width"), "Width")
+    height, _ = _length_with_unit(header.get("height"), "Height")
+    ny, nx = table.shape
+    metadata = {"title": header["channel"]} if header.get("channel") else {}
+    units = Units(xy_unit, z_unit)
+    if ny == 1:
+        return Surface(table[0] * z_factor, (width / nx,), units=units, metadata=metadata)
+    return Surface(table * z_factor, (width / nx, height / ny), units=units, metadata=metadata)
+
+
+def _key_value_matrix(lines, options):
+    header, position = {}, 0
+    while position < len(lines) and not _NUMERIC.match(lines[position]):
+        for key, value in re.findall(r"([^=]+?)\s*=\s*(\S+(?:\s+[A-Za-zµμ]+$)?)(?:\s+|$)", lines[position].strip()):
+            header[key.strip().lower()] = value.strip()
+        position += 1
+    table = _numbers(lines[position:], None, None)
+    rows, columns = header.get("h"), header.get("w")
+    if rows is not None and columns is not None and (int(rows), int(columns)) != table.shape:
+        raise FormatError(f"header says {rows} rows × {columns} columns, the data have {table.shape[0]} × {table.shape[1]}")
+    if "pixel size" in header:
+        pixel, xy_unit = _length_with_unit(header["pixel size"], "pixel size")
+        spacing = (pixel, pixel)
+    elif options.spacing is not None:
+        spacing, xy_unit = options.spacing, "m"
+    else:
+        raise FormatError("no pixel size in the header; give the spacing with --spacing")
+    factor_key = next((k for k in header if k.startswith("height conversion factor")), None)
+    if factor_key:
+        z_factor, z_unit = float(header[factor_key]), "m"
+    else:
+        z_unit = options.unit or "m"
+        z_factor = metres_per(z_unit)
+    units = Units(xy_unit, header.get("data unit", z_unit))
+    if table.shape[0] == 1:
+        return Surface(table[0] * z_factor, spacing[:1], units=units)
+    return Surface(table * z_factor, spacing, units=units)
+
+
+# -- pieces --------------------------------------------------------------------------
+
+
+def _decode(data):
+    raw = bytes(data)
+    if raw.startswith((b"\xff\xfe", b"\xfe\xff")):
+        return raw.decode("utf-16")
+    raw = raw.removeprefix(b"\xef\xbb\xbf")
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError:
+        return raw.decode("latin-1")
+
+
+def _comment_settings(comments):
+    """``unit``, ``spacing``, ``origin`` and rough's provenance from ``# key: value``."""
+    settings, history = {}, []
+    for comment in comments:
+        key, colon, value = comment.partition(":")
+        key = key.strip().lower()
+        if not colon:
+            continue
+        if key == "history":
+            history.append(json.loads(value))
+        elif key in ("unit", "spacing", "origin", "units", "metadata"):
+            settings[key] = value.strip()
+    settings["history"] = history
+    return settings
+
+
+def _column_names(body):
+    """Split off a line of column names and a line of units, if the data have them."""
+    names, units_row = [], None
+    if body and not _NUMERIC.match(body[0]):
+        names = _split(body[0], _delimiter(body[0]))
+        body = body[1:]
+        if body and not _NUMERIC.match(body[0]):
+            units_row = _split(body[0], _delimiter(body[0]))
+            body = body[1:]
+    return names, units_row, body
+
+
+def _delimiter(line):
+    for candidate in (";", "\t", ","):
+        if candidate in line:
+            return candidate
+    return None
+
+
+def _split(line, delimiter):
+    return [part.strip() for part in (line.split(delimiter) if delimiter else line.split())]
+
+
+def _numbers(body, delimiter, columns):
+    """The numeric table of the data lines, rows × columns, NaN for ``BAD``/``nan``.
+    ``columns`` defaults to as many as the first line has (trailing separators aside)."""
+    block = "\n".join(body)
+    if delimiter in (";", "\t") and any("," in line for line in body[:10]):
+        block = block.replace(",", ".")
+    if any(marker in block for marker in ("BAD", "bad", "Bad")):
+        block = _BAD.sub("nan", block)
+    if columns is None:
+        columns = range(len(_split(body[0].rstrip(delimiter or None), delimiter)))
+    try:
+        table = np.loadtxt(io.StringIO(block), delimiter=delimiter, usecols=tuple(columns), ndmin=2, comments=None)
+    except ValueError as error:
+        raise FormatError(f"unreadable number in the data ({error})") from None
+    if table.size == 0:
+        raise FormatError("no numeric data found")
+    return table
+
+
+def _unit_of(name, default):
+    """The length unit named in a column name such as ``x[um]``, ``z (nm)`` or ``Lateral um``."""
+    match = _UNIT_IN_NAME.search(name or "")
+    if match:
+        candidate = match.group(1) or match.group(2)
+        try:
+            metres_per(candidate)
+            return candidate
+        except InputError:
+            pass
+    return default
+
+
+def _length_with_unit(text, what):
+    match = re.match(r"^\s*([-+0-9.eE]+)\s*(\S*)\s*$", text or "")
+    if not match:
+        raise FormatError(f"cannot read the {what} {text!r}")
+    value, unit = float(match.group(1)), match.group(2) or "m"
+    length = value * metres_per(unit)
+    if not length > 0:
+        raise FormatError(f"the {what} must be a positive length, not {text!r}")
+    return length, unit
+
+
+def _quanta(tokens):
+    """How finely each printed number resolves its value: ``'1.25'`` → 0.01,
+    ``'3e-05'`` → 1e-05, ``'7'`` → 1."""
+    quanta = []
+    for token in tokens:
+        mantissa, _, exponent = token.strip().lower().partition("e")
+        quanta.append(10.0 ** (int(exponent or 0) - len(mantissa.partition(".")[2])))
+    return np.array(quanta)
+
+
+def _regular(values, tokens, what):
+    """``(step, start)`` of evenly spaced values by least squares. Values must lie on
+    the line exactly, or within the rounding of the digits they were printed with
+    (``tokens``, a callable giving the printed text of each value, is asked only then)."""
+    n = len(values)
+    if n < 2:
+        raise FormatError(f"a single {what} value gives no spacing")
+    index = np.arange(n)
+    step, start = np.polyfit(index, values, 1)
+    deviation = np.abs(values - (start + step * index))
+    if step > 0 and deviation.max() <= 1e-9 * step * n:
+        return float(step), float(start)
+    rounding = 0.6 * _quanta(tokens()) if step > 0 else np.inf
+    if not (step > 0 and np.all(deviation <= rounding) and rounding.max() < 0.5 * step):
+        steps = np.diff(values)
+        raise FormatError(
+            f"{what} values are not evenly spaced (steps from {steps.min():.6g} to {steps.max():.6g}); "
+            "rough needs a regular grid, so resample them first"
+        )
+    return float(step), float(start)
+
+
+def _level_tokens(levels):
+    """The distinct grid coordinates printed back as the shortest text that gives each."""
+    return lambda: [repr(float(level)) for level in levels]
+
+
+def _column_tokens(body, delimiter, column):
+    return lambda: [_split(line, delimiter)[column] for line in body]
+
+
+def _profile(x, z, x_unit, z_unit, settings, body, delimiter):
+    if len(x) < 2:
+        raise FormatError("a profile needs at least two points to have a spacing")
+    if x[-1] < x[0]:
+        x, z = x[::-1], z[::-1]
+    x_factor, z_factor = metres_per(x_unit), metres_per(z_unit)
+    if "spacing" in settings:
+        step, start = _floats(settings["spacing"])[0] / x_factor, x[0]
+    else:
+        step, start = _regular(x, _column_tokens(body, delimiter, 0), "x")
+    metadata, units, history = _provenance(settings, Units(x_unit, z_unit))
+    return Surface(z * z_factor, (step * x_factor,), (start * x_factor,), units, metadata, history)
+
+
+def _grid(table, units, settings, body, delimiter):
+    x, y, z = table.T
+    factors = [metres_per(u) for u in units[:3]]
+    given = _floats(settings["spacing"]) if "spacing" in settings else None
+    axes = []
+    for column, values in enumerate((x, y)):
+        levels = np.unique(values[~np.isnan(values)])
+        if given:
+            step, start = given[column] / factors[column], levels[0]
+        else:
+            step, start = _regular(levels, _level_tokens(levels), "xy"[column]) if len(levels) > 1 else (1.0, levels[0])
+        index = np.rint((values - start) / step)
+        if np.max(np.abs(values - (start + index * step))) > 0.25 * step:
+            raise FormatError(f"irregular grid: {'xy'[column]} values do not fall on a regular grid")
+        axes.append((index.astype(np.int64), int(index.max()) + 1, step * factors[column], start * factors[column]))
+    (ix, nx, dx, x0), (iy, ny, dy, y0) = axes
+    if nx * ny > 4 * len(z) + 16:
+        raise FormatError(f"x y z points cover only {len(z)} of the {nx}×{ny} grid they span")
+    heights = np.full((ny, nx), np.nan)
+    flat = iy * nx + ix
+    if len(np.unique(flat)) != len(flat):
+        raise FormatError("x y z grid has more than one height at the same point")
+    heights.ravel()[flat] = z * factors[2]
+    metadata, surface_units, history = _provenance(settings, Units(units[0], units[2]))
+    if nx * ny == 1:
+        raise FormatError("a single x y z point is not a surface")
+    if ny == 1:
+        return Surface(heights[0], (dx,), (x0,), surface_units, metadata, history)
+    if nx == 1:
+        return Surface(heights[:, 0], (dy,), (y0,), surface_units, metadata, history)
+    return Surface(heights, (dx, dy), (x0, y0), surface_units, metadata, history)
+
+
+def _from_spacing(heights, options, settings, units):
+    if "spacing" in settings:
+        spacing = tuple(_floats(settings["spacing"]))
+    elif options.spacing is not None:
+        spacing = options.spacing
+    else:
+        raise FormatError("a column of heights without x needs the spacing: give --spacing (e.g. --spacing 1um)")
+    metadata, units, history = _provenance(settings, units)
+    return Surface(heights, spacing[: np.ndim(heights)], units=units, metadata=metadata, history=history)
+
+
+def _provenance(settings, units):
+    return provenance.restore(
+        {"units": settings.get("units"), "metadata": settings.get("metadata"), "history": settings.get("history")},
+        units=units,
+    )
+
+
+def _floats(text):
+    return [float(value) for value in text.split()]
+

@@ -1,0 +1,453 @@
+"""X3P: ISO 25178-72 (the ISO 5436-2 XML container), read and written.
+
+A zip holding ``main.xml`` (namespace ``http://www.opengps.eu/2008/ISO5436_2``),
+``md5checksum.hex`` (the MD5 of ``main.xml``) and, for binary data,
+``bindata/data.bin`` (little-endian, x fastest) with an optional packed bit mask of
+valid points (LSB first).
+
+Reading: PRF and SUR features; int16/int32/float32/float64 data (``Increment`` scales
+integer data, ``Offset`` shifts every type); binary data or an inline ``DataList``;
+the valid-point mask and empty ``<Datum/>`` become NaN; absolute X/Y axes are accepted
+where their coordinates form a regular grid; ``main.xml`` may sit under a folder and
+start with a BOM; Record2 is optional. Every MD5 the schema defines is checked
+(``verify=False`` downgrades a mismatch to a warning). Point clouds (PCL), irregular
+grids and files with a DOCTYPE are refused. Only the first layer of a multi-layer
+file is read.
+
+Writing: PRF for profiles, SUR for maps, float64 data, stored (uncompressed) members
+with the data aligned to 64 bytes, and rough's units, metadata and history in a
+vendor-specific member named by the root's ``VendorSpecificID``, which other readers
+ignore.
+"""
+
+import hashlib
+import io
+import json
+import logging
+import re
+import struct
+import weakref
+import zipfile
+import zlib
+from xml.etree import ElementTree
+from xml.sax.saxutils import escape as _escape
+
+import numpy as np
+
+from . import provenance
+from .. import __version__
+from ..errors import FormatError
+from ..surface import Surface, Units, timestamp
+
+NAMESPACE = "http://www.opengps.eu/2008/ISO5436_2"
+VENDOR_ID = "urn:x-rough:x3p-vendor:1"
+VENDOR_MEMBER = "vendor/rough.json"
+DATA_TYPES = {"I": "<i2", "L": "<i4", "F": "<f4", "D": "<f8"}
+MAX_POINTS = 1 << 31
+MAX_XML_BYTES = 1 << 31
+MAX_SIDE_BYTES = 1 << 26
+ALIGNMENT = 64
+
+log = logging.getLogger("rough")
+
+
+def read(data, options):
+    try:
+        archive = zipfile.ZipFile(io.BytesIO(data))
+    except zipfile.BadZipFile as error:
+        raise FormatError(f"not a valid X3P zip archive ({error})") from None
+    prefix, main_name = _find_main(archive)
+    document = _member(archive, main_name, data, limit=MAX_XML_BYTES)
+    root = _parse_xml(bytes(document))
+    _check(options.verify, _main_checksum_problem(archive, prefix, root, document, data))
+
+    feature = _text(root, "Record1/FeatureType", required=True).upper()
+    if feature == "PCL" or root.find("Record3/ListDimension") is not None:
+        raise FormatError("X3P point clouds (FeatureType PCL) are not supported: rough needs a regular grid")
+    if feature not in ("SUR", "PRF"):
+        raise FormatError(f"unknown X3P FeatureType {feature!r} (expected SUR or PRF)")
+    axes = {name: _axis(root, name) for name in ("CX", "CY", "CZ")}
+    if axes["CZ"]["type"] != "A":
+        raise FormatError("the X3P z axis (CZ) must be absolute (AxisType A)")
+    nx, ny, layers = (_size(root, f"Record3/MatrixDimension/Size{c}") for c in "XYZ")
+    if nx * ny * layers > MAX_POINTS:
+        raise FormatError(f"MatrixDimension declares {nx}×{ny}×{layers} points, more than rough handles")
+    if feature == "PRF" and ny != 1:
+        raise FormatError(f"an X3P profile (PRF) must have SizeY 1, not {ny}")
+    if layers > 1:
+        log.warning("X3P file holds %d layers; reading the first", layers)
+
+    absolute = [name for name in ("CX", "CY") if axes[name]["type"] == "A"]
+    fields = [(name, axes[name]["dtype"]) for name in (*absolute, "CZ")]
+    count = nx * ny * layers
+    digest = None
+    if root.find("Record3/DataLink") is not None:
+        records, valid, digest = _binary_records(archive, prefix, root, data, fields, count, options.verify)
+    elif root.find("Record3/DataList") is not None:
+        records, valid = _list_records(root, fields, count)
+    else:
+        raise FormatError("Record3 has neither a DataLink nor a DataList: no data")
+    records = records[: nx * ny]
+    valid = None if valid is None or valid[: nx * ny].all() else valid[: nx * ny]
+
+    heights = _scaled(records["CZ"], axes["CZ"])
+    if valid is not None:
+        heights = np.where(valid, heights, np.nan)
+    spacing, origin = [], []
+    for name, n in (("CX", nx), ("CY", ny))[: 1 if ny == 1 else 2]:
+        step, start = _grid(name, axes[name], records, valid, n, nx, ny)
+        spacing.append(step)
+        origin.append(start)
+    heights = heights.reshape(ny, nx) if ny > 1 else heights.reshape(nx)
+    if digest and fields == [("CZ", "<f8")] and not axes["CZ"]["offset"] and valid is None:
+        _remember_digest(heights, digest)
+    if _text(root, "VendorSpecificID") == VENDOR_ID and f"{prefix}{VENDOR_MEMBER}" in archive.namelist():
+        metadata, units, history = _vendor(archive, prefix, data)
+    else:
+        metadata, units, history = _metadata(root), Units("m", "m"), []
+    return Surface(heights, tuple(spacing), tuple(origin), units, metadata, history)
+
+
+def write(surface, stream):
+    heights = np.ascontiguousarray(surface.heights, dtype="<f8")
+    payload = memoryview(heights).cast("B")
+    invalid = np.isnan(heights)
+    mask = np.packbits(~invalid.ravel(), bitorder="little").tobytes() if invalid.any() else None
+    document = _main_xml(surface, _digest_of(heights, payload), mask and hashlib.md5(mask).hexdigest())
+    vendor = json.dumps(provenance.parts(surface), indent=1).encode("utf-8")
+    with zipfile.ZipFile(stream, "w", compression=zipfile.ZIP_STORED, allowZip64=True) as archive:
+        _store(archive, "main.xml", document)
+        _store(archive, "md5checksum.hex", f"{hashlib.md5(document).hexdigest()} *main.xml\n".encode())
+        _store(archive, "bindata/data.bin", payload, align=ALIGNMENT)
+        if mask is not None:
+            _store(archive, "bindata/valid.bin", mask)
+        _store(archive, VENDOR_MEMBER, vendor)
+
+
+# -- reading -------------------------------------------------------------------------
+
+
+def _find_main(archive):
+    candidates = [
+        name for name in archive.namelist()
+        if (name == "main.xml" or name.endswith("/main.xml")) and not name.startswith("__MACOSX/")
+    ]
+    if not candidates:
+        raise FormatError("zip archive without main.xml: not an X3P file")
+    main = min(candidates, key=len)
+    return main[: -len("main.xml")], main
+
+
+def _member(archive, name, data, limit=None, expected=None, check_crc=True):
+    """A member's bytes; stored members are returned as a zero-copy view of ``data``
+    after their CRC is checked (unless the caller checks an MD5 of them instead).
+    Sizes are checked before anything is read."""
+    try:
+        info = archive.getinfo(name)
+    except KeyError:
+        raise FormatError(f"the archive has no member {name!r}") from None
+    if expected is not None and info.file_size != expected:
+        raise FormatError(f"{name} holds {info.file_size} bytes, but the header implies {expected}")
+    if limit is not None and info.file_size > limit:
+        raise FormatError(f"{name} is {info.file_size} bytes, more than rough reads ({limit})")
+    if info.compress_type == zipfile.ZIP_STORED and not info.flag_bits & 0x1:
+        view = memoryview(data)
+        header = bytes(view[info.header_offset: info.header_offset + 30])
+        if len(header) < 30 or header[:4] != b"PK\x03\x04":
+            raise FormatError(f"damaged zip: no local header for {name}")
+        start = info.header_offset + 30 + sum(struct.unpack("<HH", header[26:30]))
+        content = view[start: start + info.file_size]
+        if len(content) != info.file_size:
+            raise FormatError(f"truncated archive: {name} is cut short")
+        if check_crc and zlib.crc32(content) != info.CRC:
+            raise FormatError(f"{name} fails its zip CRC check: the archive is damaged")
+        return content
+    with archive.open(info) as member:
+        content = member.read(info.file_size + 1)
+    if len(content) != info.file_size:
+        raise FormatError(f"{name} does not hold the {info.file_size} bytes its zip entry declares")
+    return content
+
+
+def _parse_xml(document):
+    if b"<!DOCTYPE" in document or b"<!ENTITY" in document:
+        raise FormatError("main.xml declares a DOCTYPE or entities, which X3P does not use; refusing to parse it")
+    document = document.removeprefix(b"\xef\xbb\xbf")
+    try:
+        root = ElementTree.fromstring(document)
+    except ElementTree.ParseError as error:
+        raise FormatError(f"main.xml is not well-formed XML ({error})") from None
+    for element in root.iter():
+        if isinstance(element.tag, str):
+            element.tag = element.tag.rpartition("}")[2].rpartition(":")[2]
+    if not root.tag.startswith("ISO5436"):
+        raise FormatError(f"main.xml root is <{root.tag}>, not an ISO 5436-2 document")
+    return root
+
+
+def _main_checksum_problem(archive, prefix, root, document, data):
+    name = _text(root, "Record4/ChecksumFile") or "md5checksum.hex"
+    member = f"{prefix}{name}"
+    if member not in archive.namelist():
+        return f"the checksum file {name} named by Record4 is missing"
+    stated = bytes(_member(archive, member, data, limit=4096)).split()
+    actual = hashlib.md5(document).hexdigest()
+    if not stated or stated[0].decode("ascii", "replace").lower() != actual:
+        shown = stated[0][:32].decode("ascii", "replace") if stated else "nothing"
+        return f"main.xml checksum mismatch ({name} says {shown}, main.xml is {actual})"
+    return None
+
+
+def _check(verify, problem):
+    if problem is None:
+        return
+    if verify:
+        raise FormatError(f"{problem}; the file may be damaged (--ignore-checksums reads it anyway)")
+    log.warning("%s; reading anyway", problem)
+
+
+def _text(root, path, required=False, default=None):
+    element = root.find(path)
+    if element is None or element.text is None or not element.text.strip():
+        if required:
+            raise FormatError(f"main.xml lacks {path.replace('/', ' > ')}")
+        return default
+    return element.text.strip()
+
+
+def _number(root, path, default):
+    text = _text(root, path)
+    if text is None:
+        return default
+    try:
+        value = float(text)
+    except ValueError:
+        raise FormatError(f"{path.replace('/', ' > ')} is not a number: {text!r}") from None
+    if not np.isfinite(value):
+        raise FormatError(f"{path.replace('/', ' > ')} is not finite: {text!r}")
+    return value
+
+
+def _axis(root, name):
+    base = f"Record1/Axes/{name}"
+    if root.find(base) is None:
+        raise FormatError(f"main.xml lacks the axis description {name}")
+    kind = _text(root, f"{base}/AxisType", required=True).upper()
+    if kind not in ("I", "A"):
+        raise FormatError(f"{name} AxisType must be I or A, not {kind!r}")
+    code = (_text(root, f"{base}/DataType") or "D").upper()
+    if code not in DATA_TYPES:
+        raise FormatError(f"{name} DataType must be one of I, L, F, D, not {code!r}")
+    return {
+        "type": kind,
+        "code": code,
+        "dtype": DATA_TYPES[code],
+        "increment": _number(root, f"{base}/Increment", 1.0),
+        "offset": _number(root, f"{base}/Offset", 0.0),
+    }
+
+
+def _size(root, path):
+    text = _text(root, path, required=True)
+    if not text.isdigit() or int(text) < 1:
+        raise FormatError(f"{path.replace('/', ' > ')} must be a positive whole number, not {text!r}")
+    return int(text)
+
+
+def _binary_records(archive, prefix, root, data, fields, count, verify):
+    """``(records, valid mask or None, the data's MD5 if it was verified)``."""
+    link = _text(root, "Record3/DataLink/PointDataLink", required=True)
+    record = np.dtype(fields)
+    stated = _text(root, "Record3/DataLink/MD5ChecksumPointData")
+    payload = _member(archive, f"{prefix}{link}", data, expected=count * record.itemsize, check_crc=not (verify and stated))
+    actual = hashlib.md5(payload).hexdigest()
+    _check(verify, _md5_problem(actual, stated, link))
+    records = np.frombuffer(payload, dtype=record)
+    verified = actual if stated and stated.lower() == actual else None
+    valid_link = _text(root, "Record3/DataLink/ValidPointsLink")
+    if valid_link is None:
+        return records, None, verified
+    packed = _member(archive, f"{prefix}{valid_link}", data, limit=MAX_POINTS // 8 + 1)
+    _check(verify, _md5_problem(hashlib.md5(packed).hexdigest(), _text(root, "Record3/DataLink/MD5ChecksumValidPoints"), valid_link))
+    if len(packed) < (count + 7) // 8:
+        raise FormatError(f"{valid_link} holds {len(packed)} bytes, too few for {count} points")
+    valid = np.unpackbits(np.frombuffer(packed, np.uint8), count=count, bitorder="little").astype(bool)
+    return records, valid, verified
+
+
+def _md5_problem(actual, stated, name):
+    if stated is None:
+        return f"main.xml gives no MD5 checksum for {name}"
+    if stated.lower() != actual:
+        return f"{name} checksum mismatch (main.xml says {stated}, the data are {actual})"
+    return None
+
+
+def _list_records(root, fields, count):
+    datums = root.findall("Record3/DataList/Datum")
+    if len(datums) != count:
+        raise FormatError(f"DataList holds {len(datums)} points, but MatrixDimension declares {count}")
+    records = np.zeros(count, dtype=[(name, "<f8") for name, _ in fields])
+    valid = np.ones(count, bool)
+    width = len(fields)
+    for index, datum in enumerate(datums):
+        text = (datum.text or "").strip()
+        if not text:
+            valid[index] = False
+            continue
+        values = text.split(";")
+        if len(values) < width:
+            raise FormatError(f"Datum {index + 1} has {len(values)} values, needs {width}: {text!r}")
+        records[index] = tuple(float(v) for v in values[-width:])
+    return records, valid
+
+
+def _scaled(raw, axis):
+    values = raw.astype(np.float64) if raw.dtype != np.float64 else raw
+    if axis["code"] in ("I", "L"):
+        values = values * axis["increment"]
+    return values + axis["offset"] if axis["offset"] else values
+
+
+def _grid(name, axis, records, valid, n, nx, ny):
+    """Spacing and origin of an axis; absolute coordinates must lie on a regular grid."""
+    if axis["type"] == "I":
+        if not axis["increment"] > 0:
+            raise FormatError(f"{name} Increment must be a positive length, not {axis['increment']}")
+        return axis["increment"], axis["offset"]
+    coordinates = _scaled(records[name], axis)
+    if valid is not None:
+        coordinates = np.where(valid, coordinates, np.nan)
+    coordinates = coordinates.reshape(ny, nx)
+    along = np.nanmean(coordinates, axis=0 if name == "CX" else 1)
+    if n < 2 or np.isnan(along).any():
+        raise FormatError(f"cannot find a regular grid in the absolute {name} coordinates")
+    step = (along[-1] - along[0]) / (n - 1)
+    expected = along[0] + step * np.arange(n)
+    full = expected[np.newaxis, :] if name == "CX" else expected[:, np.newaxis]
+    if not step > 0 or np.nanmax(np.abs(coordinates - full)) > 1e-6 * step:
+        raise FormatError(f"irregular grid: the absolute {name} coordinates are not evenly spaced (rough needs a regular grid)")
+    return float(step), float(along[0])
+
+
+def _metadata(root):
+    record = {
+        "date": "Record2/Date",
+        "creator": "Record2/Creator",
+        "instrument_manufacturer": "Record2/Instrument/Manufacturer",
+        "instrument_model": "Record2/Instrument/Model",
+        "instrument_serial": "Record2/Instrument/Serial",
+        "instrument_version": "Record2/Instrument/Version",
+        "calibration_date": "Record2/CalibrationDate",
+        "probing_type": "Record2/ProbingSystem/Type",
+        "probing_identification": "Record2/ProbingSystem/Identification",
+        "comment": "Record2/Comment",
+    }
+    metadata = {key: _text(root, path) for key, path in record.items()}
+    return {key: value for key, value in metadata.items() if value is not None}
+
+
+def _vendor(archive, prefix, data):
+    """rough's own record, which holds the metadata that Record2 was written from."""
+    stored = json.loads(bytes(_member(archive, f"{prefix}{VENDOR_MEMBER}", data, limit=MAX_SIDE_BYTES)))
+    return provenance.restore(stored, units=Units("m", "m"))
+
+
+# -- writing -------------------------------------------------------------------------
+
+_verified_digests = {}
+
+
+def _remember_digest(heights, digest):
+    """Remember the verified MD5 of a read-only height array that views the bytes it
+    was read from, so that writing the same array again need not hash it again. The
+    array cannot change: its memory belongs to an immutable bytes object."""
+    for key in [key for key, (ref, _) in _verified_digests.items() if ref() is None]:
+        del _verified_digests[key]
+    if not heights.flags.writeable:
+        _verified_digests[id(heights)] = (weakref.ref(heights), digest)
+
+
+def _digest_of(heights, payload):
+    ref, digest = _verified_digests.get(id(heights), (lambda: None, None))
+    return digest if ref() is heights else hashlib.md5(payload).hexdigest()
+
+
+
+def _store(archive, name, content, align=None):
+    info = zipfile.ZipInfo(name, date_time=_zip_time())
+    info.compress_type = zipfile.ZIP_STORED
+    info.external_attr = 0o644 << 16
+    if align:
+        header_end = archive.fp.tell() + 30 + len(name.encode()) + 6
+        padding = -header_end % align
+        info.extra = struct.pack("<HHH", 0xD935, 2 + padding, align) + bytes(padding)
+    archive.writestr(info, content)
+
+
+def _zip_time():
+    stamp = timestamp()
+    return tuple(int(part) for part in (stamp[0:4], stamp[5:7], stamp[8:10], stamp[11:13], stamp[14:16], stamp[17:19]))
+
+
+def _main_xml(surface, data_md5, mask_md5):
+    m = surface.metadata
+    now = timestamp()
+    axes = "".join(
+        f"<{name}><AxisType>I</AxisType><DataType>D</DataType>"
+        f"<Increment>{step!r}</Increment><Offset>{start!r}</Offset></{name}>"
+        for name, step, start in zip(
+            ("CX", "CY"),
+            _pad(surface.spacing),
+            _pad(surface.origin, 0.0),
+        )
+    )
+    probing = m.get("probing_type") if m.get("probing_type") in ("Contacting", "NonContacting", "Software") else "Software"
+    fields = {
+        "manufacturer": m.get("instrument_manufacturer") or m.get("instrument") or "not available",
+        "model": m.get("instrument_model") or "not available",
+        "serial": m.get("instrument_serial") or "not available",
+        "version": m.get("instrument_version") or "not available",
+        "identification": m.get("probing_identification") or f"rough {__version__}",
+    }
+    fields = {key: escape(value) for key, value in fields.items()}
+    comment = f"<Comment>{escape(m['comment'])}</Comment>" if m.get("comment") else ""
+    creator = f"<Creator>{escape(m['creator'])}</Creator>" if m.get("creator") else ""
+    valid = (
+        f"<ValidPointsLink>bindata/valid.bin</ValidPointsLink><MD5ChecksumValidPoints>{mask_md5}</MD5ChecksumValidPoints>"
+        if mask_md5 else ""
+    )
+    nx, ny = (*surface.points, 1)[:2]
+    return (
+        '<?xml version="1.0" encoding="UTF-8"?>\n'
+        f'<p:ISO5436_2 xmlns:p="{NAMESPACE}">\n'
+        f"<Record1><Revision>ISO5436 - 2000</Revision><FeatureType>{'PRF' if surface.is_profile else 'SUR'}</FeatureType>"
+        f"<Axes>{axes}<CZ><AxisType>A</AxisType><DataType>D</DataType><Increment>1.0</Increment><Offset>0.0</Offset></CZ></Axes></Record1>\n"
+        f"<Record2><Date>{escape(m.get('date') or now)}</Date>{creator}"
+        f"<Instrument><Manufacturer>{fields['manufacturer']}</Manufacturer><Model>{fields['model']}</Model>"
+        f"<Serial>{fields['serial']}</Serial><Version>{fields['version']}</Version></Instrument>"
+        f"<CalibrationDate>{escape(m.get('calibration_date') or m.get('date') or now)}</CalibrationDate>"
+        f"<ProbingSystem><Type>{probing}</Type><Identification>{fields['identification']}</Identification></ProbingSystem>"
+        f"{comment}</Record2>\n"
+        f"<Record3><MatrixDimension><SizeX>{nx}</SizeX><SizeY>{ny}</SizeY><SizeZ>1</SizeZ></MatrixDimension>"
+        f"<DataLink><PointDataLink>bindata/data.bin</PointDataLink><MD5ChecksumPointData>{data_md5}</MD5ChecksumPointData>"
+        f"{valid}</DataLink></Record3>\n"
+        "<Record4><ChecksumFile>md5checksum.hex</ChecksumFile></Record4>\n"
+        f"<VendorSpecificID>{VENDOR_ID}</VendorSpecificID>\n"
+        "</p:ISO5436_2>\n"
+    ).encode("utf-8")
+
+
+_NOT_XML = re.compile("[^\t\n\r\u0020-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")
+
+
+def escape(text):
+    """Text made safe for an XML 1.0 element: markup escaped, characters that XML
+    cannot hold (control characters, lone surrogates) replaced by U+FFFD. The exact
+    text travels in the vendor member."""
+    return _escape(_NOT_XML.sub("\ufffd", str(text)))
+
+
+def _pad(values, fill=None):
+    """Two values for CX and CY; a profile repeats its one spacing (or uses ``fill``)."""
+    return (values[0], values[1]) if len(values) == 2 else (values[0], values[0] if fill is None else fill)

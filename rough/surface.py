@@ -1,0 +1,139 @@
+"""The data model: a measured or synthesised profile (1-D) or height map (2-D).
+
+Conventions (SPEC §3): heights are float64 metres, a profile is ``z[x]`` and a map
+``z[y, x]`` (row-major, x fastest, as in X3P). ``spacing`` is ``(dx,)`` or
+``(dx, dy)`` in metres; the physical length is ``n * dx``. NaN marks invalid points.
+"""
+
+import dataclasses
+import datetime
+import os
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import __version__
+from .errors import InputError
+
+
+@dataclass(frozen=True)
+class Units:
+    """The units a surface's source file used for lateral (``xy``) and height (``z``)
+    values. Informational: rough always holds metres."""
+
+    xy: str = "m"
+    z: str = "m"
+
+
+@dataclass(eq=False)
+class Surface:
+    """A profile or height map.
+
+    Attributes:
+        heights: float64 metres, shape ``(nx,)`` or ``(ny, nx)``; NaN marks invalid points.
+        spacing: ``(dx,)`` or ``(dx, dy)``, metres, finite and positive.
+        origin: position of the first point, ``(x0,)`` or ``(x0, y0)``, metres.
+        units: the units the data came in (see :class:`Units`).
+        metadata: strings such as ``title``, ``instrument``, ``date``, ``source``.
+        history: one entry per command that made or changed the surface, oldest first:
+            ``{"command", "parameters", "version", "time"}``.
+        source_format: the format the surface was read from (a key of
+            ``rough.io.FORMATS``), or None for a surface made or changed in memory.
+    """
+
+    heights: np.ndarray
+    spacing: tuple
+    origin: tuple = None
+    units: Units = field(default_factory=Units)
+    metadata: dict = field(default_factory=dict)
+    history: list = field(default_factory=list)
+    source_format: str = field(default=None, compare=False)
+
+    def __post_init__(self):
+        heights = np.asarray(self.heights)
+        if heights.dtype != np.float64:
+            if not (np.issubdtype(heights.dtype, np.floating) or np.issubdtype(heights.dtype, np.integer)):
+                raise InputError(f"heights must be numbers, not {heights.dtype}")
+            heights = heights.astype(np.float64)
+        if heights.ndim not in (1, 2):
+            raise InputError(f"a surface is a profile (1-D) or a map (2-D), not {heights.ndim}-D")
+        if heights.size == 0:
+            raise InputError("a surface needs at least one point")
+        self.heights = heights
+        self.spacing = _lengths(self.spacing, heights.ndim, "spacing", positive=True)
+        self.origin = _lengths(self.origin or (0.0,) * heights.ndim, heights.ndim, "origin")
+
+    @property
+    def is_profile(self):
+        return self.heights.ndim == 1
+
+    @property
+    def kind(self):
+        return "profile" if self.is_profile else "map"
+
+    @property
+    def points(self):
+        """Points along each axis, x first: ``(nx,)`` or ``(nx, ny)``."""
+        return tuple(reversed(self.heights.shape))
+
+    @property
+    def size(self):
+        """Physical size along each axis, x first, in metres (``n * spacing``)."""
+        return tuple(n * d for n, d in zip(self.points, self.spacing))
+
+    @property
+    def valid(self):
+        """Boolean mask of the valid (non-NaN) points."""
+        return ~np.isnan(self.heights)
+
+    def derive(self, command, parameters, **changes):
+        """A new surface with ``changes`` applied (e.g. ``heights=...``) and one history
+        entry appended for ``command`` with its ``parameters`` (JSON-able values)."""
+        entry = history_entry(command, parameters)
+        return dataclasses.replace(
+            self, history=[*self.history, entry], metadata=dict(self.metadata), source_format=None, **changes
+        )
+
+    def write(self, target, format=None):
+        """Write to a path or binary stream, atomically for paths. ``format`` is one of
+        ``x3p``, ``exr``, ``gsf``, ``tsv``, ``npy``; by default it follows the file
+        extension, and a stream gets X3P."""
+        from .io import write
+
+        write(self, target, format=format)
+
+    def __repr__(self):
+        dims = " × ".join(str(n) for n in self.points)
+        steps = ", ".join(f"{d:g}" for d in self.spacing)
+        return f"<Surface {self.kind} {dims} points, spacing ({steps}) m, {len(self.history)} history entries>"
+
+
+def history_entry(command, parameters):
+    """One history entry stamped with rough's version and the time (UTC). The time is
+    ``SOURCE_DATE_EPOCH`` when that is set, so that seeded output can be bit-identical."""
+    return {"command": command, "parameters": dict(parameters), "version": __version__, "time": timestamp()}
+
+
+def timestamp():
+    """Now (or ``SOURCE_DATE_EPOCH``) as an ISO 8601 UTC string to the second."""
+    epoch = os.environ.get("SOURCE_DATE_EPOCH")
+    moment = (
+        datetime.datetime.fromtimestamp(int(epoch), datetime.timezone.utc)
+        if epoch and epoch.isdigit()
+        else datetime.datetime.now(datetime.timezone.utc)
+    )
+    return moment.strftime("%Y-%m-%dT%H:%M:%SZ")
+
+
+def _lengths(values, ndim, name, positive=False):
+    try:
+        values = tuple(float(v) for v in np.atleast_1d(values))
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be numbers (metres), not {values!r}") from None
+    if len(values) == 1 and ndim == 2:
+        values = values * 2
+    if len(values) != ndim:
+        raise InputError(f"a {ndim}-D surface needs {ndim} {name} values, got {len(values)}")
+    if not all(np.isfinite(values)) or (positive and min(values) <= 0):
+        raise InputError(f"{name} must be finite{' and positive' if positive else ''}, got {values}")
+    return values

@@ -1,0 +1,53 @@
+"""Fixtures shared by the tests: the third-party data folder, and running ``rough``
+as a separate process exactly as a shell user would."""
+
+import os
+import pathlib
+import subprocess
+import sys
+
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+
+
+def shared_folder():
+    """``../shared`` beside the checkout (or $ROUGH_SHARED), or None."""
+    candidate = pathlib.Path(os.environ.get("ROUGH_SHARED", ROOT.parent / "shared"))
+    return candidate if (candidate / "data" / "INDEX.md").is_file() else None
+
+
+@pytest.fixture(scope="session")
+def shared_data():
+    folder = shared_folder()
+    if folder is None:
+        pytest.skip("../shared/data (third-party reference files) is not beside this checkout")
+    return folder / "data"
+
+
+def rough(*args, input=None, check=False, env=None, timeout=120):
+    """Run ``python -m rough ARGS``; returns the CompletedProcess (bytes output)."""
+    environment = {**os.environ, **(env or {})}
+    result = subprocess.run(
+        [sys.executable, "-m", "rough", *map(str, args)],
+        input=input, capture_output=True, env=environment, timeout=timeout,
+    )
+    if check and result.returncode != 0:
+        raise AssertionError(f"rough {' '.join(map(str, args))} failed ({result.returncode}): {result.stderr.decode()}")
+    return result
+
+
+@pytest.fixture
+def run():
+    return rough
+
+
+def assert_one_line_error(result, *fragments, status=2):
+    """A failure the way SPEC §5 wants it: the status, one line on stderr that says
+    what went wrong, and no traceback."""
+    stderr = result.stderr.decode()
+    assert result.returncode == status, stderr
+    assert "Traceback" not in stderr, stderr
+    assert len(stderr.strip().splitlines()) == 1, stderr
+    for fragment in fragments:
+        assert fragment in stderr, stderr
