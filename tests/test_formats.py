@@ -235,3 +235,19 @@ def test_nonuniform_line_scan_is_refused(shared_data):
 
     with pytest.raises(InputError, match="xy-3.txt: x values are not evenly spaced"):
         read(shared_data / "SurfaceTopography/xy-3.txt")
+
+
+def test_exr_in_gwyddion_units_and_scale():
+    """As Gwyddion writes it: a Gwy::ZScale and prefixed units (µm lateral, nm heights)."""
+    import OpenEXR
+
+    header = {
+        "type": OpenEXR.scanlineimage,
+        "Gwy::XReal": np.array([30.0]), "Gwy::YReal": np.array([20.0]),
+        "Gwy::XYUnit": "µm", "Gwy::ZUnit": "nm", "Gwy::ZScale": np.array([2.0]),
+    }
+    buffer = io.BytesIO()
+    OpenEXR.File(header, {"Y": np.ones((2, 3), "f4")}).write(buffer)
+    surface = read_bytes(buffer.getvalue())
+    assert surface.spacing == pytest.approx((10e-6, 10e-6))
+    np.testing.assert_allclose(surface.heights, 2e-9)

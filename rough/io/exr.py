@@ -8,7 +8,9 @@ metadata and history go in the string attributes ``rough:units``, ``rough:metada
 and ``rough:history`` (JSON). A one-row image is a profile.
 
 Read: a single height channel, ``Y``, ``Z`` or ``R`` (in that order of preference, or
-the only channel there is), in half, float or uint pixels. Without ``Gwy::XReal`` the
+the only channel there is), in half, float or uint pixels, scaled as Gwyddion does
+(``Gwy::ZScale``, or ``Gwy::ZMin``/``Gwy::ZMax`` for integers) and in the units that
+``Gwy::XYUnit`` and ``Gwy::ZUnit`` name. Without ``Gwy::XReal`` and ``Gwy::YReal`` the
 spacing must come from ``--spacing``. Heights are float32, so a round trip keeps
 them to float32 rounding.
 """
@@ -20,6 +22,7 @@ import numpy as np
 from . import provenance
 from ..errors import FormatError
 from ..surface import Surface, Units
+from ..units import metres_per
 
 HEIGHT_CHANNELS = ("Y", "Z", "R")
 MAX_POINTS = 1 << 31
@@ -43,13 +46,15 @@ def read(data, options):
     heights = np.asarray(channels[name].pixels, dtype=np.float64)
     if heights.shape != (ny, nx):
         raise FormatError(f"EXR channel {name} has shape {heights.shape}, expected {(ny, nx)}")
-    if "Gwy::XReal" in header:
-        spacing = (_double(header, "Gwy::XReal") / nx, _double(header, "Gwy::YReal", _double(header, "Gwy::XReal") / nx * ny) / ny)
+    xy_factor = metres_per(header.get("Gwy::XYUnit") or "m")
+    heights = _scale_values(heights, header) * metres_per(header.get("Gwy::ZUnit") or "m")
+    if "Gwy::XReal" in header and "Gwy::YReal" in header:
+        spacing = (_double(header, "Gwy::XReal") * xy_factor / nx, _double(header, "Gwy::YReal") * xy_factor / ny)
     elif options.spacing is not None:
         spacing = options.spacing
     else:
-        raise FormatError("EXR file has no Gwy::XReal attribute, so no spacing; give it with --spacing")
-    origin = (_double(header, "Gwy::XOffset", 0.0), _double(header, "Gwy::YOffset", 0.0))
+        raise FormatError("EXR file has no Gwy::XReal and Gwy::YReal attributes, so no spacing; give it with --spacing")
+    origin = (_double(header, "Gwy::XOffset", 0.0) * xy_factor, _double(header, "Gwy::YOffset", 0.0) * xy_factor)
     metadata = {"title": header["Gwy::Title"]} if header.get("Gwy::Title") else {}
     units = Units(header.get("Gwy::XYUnit", "m"), header.get("Gwy::ZUnit", "m"))
     metadata, units, history = provenance.restore(
@@ -90,6 +95,15 @@ def _open(OpenEXR, data, header_only=False):
         return OpenEXR.File(io.BytesIO(bytes(data)), separate_channels=True, header_only=header_only)
     except Exception as error:  # the bindings raise plain RuntimeError/Exception for bad files
         raise FormatError(f"not a readable OpenEXR file ({error})") from None
+
+
+def _scale_values(values, header):
+    """Gwyddion's value scaling: ``Gwy::ZMin``/``Gwy::ZMax`` map the full uint32 range,
+    otherwise ``Gwy::ZScale`` is the value of 1.0 in the file."""
+    if "Gwy::ZMax" in header:
+        low = _double(header, "Gwy::ZMin", 0.0)
+        return low + values * (_double(header, "Gwy::ZMax") - low) / (2.0**32 - 1 + 0.999)
+    return values * _double(header, "Gwy::ZScale", 1.0)
 
 
 def _double(header, key, default=None):

@@ -40,8 +40,8 @@ def read(data, options):
     if len(data) - start != needed:
         raise FormatError(f"GSF declares {nx}×{ny} points ({needed} bytes) but holds {len(data) - start} bytes of data")
     heights = np.frombuffer(data, "<f4", count=nx * ny, offset=start).astype(np.float64)
-    z_factor = _factor(header.get("ZUnits"))
-    xy_factor = _factor(header.get("XYUnits"))
+    z_factor = metres_per(header.get("ZUnits") or "m")
+    xy_factor = metres_per(header.get("XYUnits") or "m")
     if z_factor != 1.0:
         heights *= z_factor
     real = [_real(header, "XReal", nx) * xy_factor, _real(header, "YReal", ny) * xy_factor]
@@ -98,16 +98,6 @@ def _real(header, key, n):
     if value <= 0:
         raise FormatError(f"GSF {key} must be a positive length, not {value}")
     return value
-
-
-def _factor(unit):
-    """Metres per unit of a GSF unit string (absent or empty: metres)."""
-    if not unit or unit == "m":
-        return 1.0
-    try:
-        return metres_per(unit)
-    except Exception:
-        raise FormatError(f"GSF unit {unit!r} is not a length unit rough knows") from None
 
 
 def _extras(header):
