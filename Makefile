@@ -26,12 +26,19 @@ demo: $(BIN)/.installed
 	@echo
 	@echo '$$ rough info --json sample_profiles/rock-map.x3p   (selected keys)'
 	@$(BIN)/rough info --json sample_profiles/rock-map.x3p | $(BIN)/python -c "import json,sys; d=json.load(sys.stdin); print({k: d[k] for k in ('shape', 'spacing', 'valid_points', 'Sq')})"
+	@echo
+	@echo '$$ rough detrend sample_profiles/rock-profile.tsv | rough features --list $(DEMO)/features.tsv --plot $(DEMO)/profile.png'
+	@$(BIN)/rough detrend sample_profiles/rock-profile.tsv | $(BIN)/rough features --list $(DEMO)/features.tsv --plot $(DEMO)/profile.png
+	@echo
+	@echo '$$ rough features sample_profiles/rock-map.x3p'
+	@$(BIN)/rough features sample_profiles/rock-map.x3p
 
 test: $(BIN)/.installed
 	$(BIN)/python -m pytest -q
 
 bench: $(BIN)/.installed
 	$(BIN)/python bench/bench_io.py
+	$(BIN)/python bench/bench_metrology.py
 
 clean:
 	rm -rf build $(VENV) *.egg-info .pytest_cache .hypothesis

@@ -13,13 +13,12 @@ machine, with the absolute times alongside:
 
 import argparse
 import os
-import statistics
 import subprocess
 import sys
 import tempfile
-import time
 
 import numpy as np
+from timing import median_time
 
 import rough
 from rough.io import read
@@ -28,31 +27,21 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROUGH = [sys.executable, "-m", "rough"]
 
 
-def best_of(repeat, action):
-    """Median wall time of ``repeat`` runs of ``action()``."""
-    times = []
-    for _ in range(repeat):
-        started = time.perf_counter()
-        action()
-        times.append(time.perf_counter() - started)
-    return statistics.median(times)
-
-
 def shell(command):
     subprocess.run(command, shell=True, check=True, stdout=subprocess.DEVNULL)
 
 
 def startup(repeat):
     rough_cli = os.path.join(os.path.dirname(sys.executable), "rough")
-    help_time = best_of(repeat * 5, lambda: subprocess.run([rough_cli, "--help"], check=True, capture_output=True))
-    bare = best_of(repeat * 5, lambda: subprocess.run([sys.executable, "-c", "pass"], check=True))
+    help_time = median_time(lambda: subprocess.run([rough_cli, "--help"], check=True, capture_output=True), repeat * 5)
+    bare = median_time(lambda: subprocess.run([sys.executable, "-c", "pass"], check=True), repeat * 5)
     print(f"start-up   rough --help {help_time * 1e3:7.1f} ms   python -c pass {bare * 1e3:6.1f} ms   ratio {help_time / bare:5.2f}×   (goal ≤ 150 ms)")
 
 
 def pipe(path, repeat):
     megabytes = os.path.getsize(path) / 1e6
-    raw = best_of(repeat, lambda: shell(f"cat {path} | cat > /dev/null"))
-    stage = best_of(repeat, lambda: shell(f"cat {path} | {' '.join(ROUGH)} convert | cat > /dev/null"))
+    raw = median_time(lambda: shell(f"cat {path} | cat > /dev/null"), repeat)
+    stage = median_time(lambda: shell(f"cat {path} | {' '.join(ROUGH)} convert | cat > /dev/null"), repeat)
     print(
         f"X3P pipe   rough convert {megabytes / stage:7.0f} MB/s ({stage:.3f} s)   raw cat {megabytes / raw:7.0f} MB/s "
         f"({raw:.3f} s)   rough costs {stage / raw:5.1f}× a raw pipe   (goal ≥ 1000 MB/s)"
@@ -61,15 +50,15 @@ def pipe(path, repeat):
 
 def formats(surface, folder, repeat):
     raw_path = os.path.join(folder, "raw.f8")
-    write_raw = best_of(repeat, lambda: surface.heights.tofile(raw_path))
-    read_raw = best_of(repeat, lambda: np.fromfile(raw_path))
+    write_raw = median_time(lambda: surface.heights.tofile(raw_path), repeat)
+    read_raw = median_time(lambda: np.fromfile(raw_path), repeat)
     print(f"raw dump   write {write_raw:7.3f} s   read {read_raw:7.3f} s   ({surface.heights.nbytes / 1e6:.0f} MB float64)")
     for fmt in ("x3p", "exr", "gsf", "npy", "tsv"):
         path = os.path.join(folder, f"map.{fmt}")
         times = 1 if fmt == "tsv" else repeat
-        written = best_of(times, lambda: surface.write(path))
+        written = median_time(lambda: surface.write(path), times)
         spacing = {"spacing": surface.spacing} if fmt == "npy" else {}
-        loaded = best_of(times, lambda: read(path, **spacing))
+        loaded = median_time(lambda: read(path, **spacing), times)
         print(
             f"{fmt:<10} write {written:7.3f} s ({written / write_raw:6.1f}× raw)   read {loaded:7.3f} s "
             f"({loaded / read_raw:6.1f}× raw)   file {os.path.getsize(path) / 1e6:7.1f} MB"

@@ -94,6 +94,26 @@ class Surface:
             self, history=[*self.history, entry], metadata=dict(self.metadata), source_format=None, **changes
         )
 
+    def positions(self, axis=0):
+        """Sample positions along ``axis`` (0 = x, 1 = y), metres."""
+        return self.origin[axis] + self.spacing[axis] * np.arange(self.points[axis])
+
+    def crop(self, x=None, y=None):
+        """The part of the surface between two positions on each axis (metres; None
+        keeps that end). A range includes the samples nearest to its ends, as an
+        instrument's cursors do: ``crop(x=(468e-6, 733e-6))`` keeps the sample at
+        467.97 µm when the spacing is 0.15625 µm. Raises InputError for a range that
+        holds fewer than two samples."""
+        bounds = [x, y][: self.heights.ndim]
+        slices, origin = [], []
+        for axis, bound in enumerate(bounds):
+            start, stop = _index_range(bound, self.origin[axis], self.spacing[axis], self.points[axis], "xy"[axis])
+            slices.append(slice(start, stop))
+            origin.append(self.origin[axis] + start * self.spacing[axis])
+        index = tuple(reversed(slices))
+        parameters = {"x": list(x) if x else None, "y": list(y) if y else None}
+        return self.derive("crop", parameters, heights=self.heights[index], origin=tuple(origin))
+
     def write(self, target, format=None):
         """Write to a path or binary stream, atomically for paths. ``format`` is one of
         ``x3p``, ``exr``, ``gsf``, ``tsv``, ``npy``; by default it follows the file
@@ -137,3 +157,17 @@ def _lengths(values, ndim, name, positive=False):
     if not all(np.isfinite(values)) or (positive and min(values) <= 0):
         raise InputError(f"{name} must be finite{' and positive' if positive else ''}, got {values}")
     return values
+
+
+def _index_range(bound, origin, spacing, count, name):
+    """``(start, stop)`` sample indices of the positions between ``bound = (low, high)``
+    (either may be None), ends rounded to the nearest sample."""
+    if bound is None:
+        return 0, count
+    low, high = bound
+    start = 0 if low is None else max(0, int(np.floor((low - origin) / spacing + 0.5)))
+    stop = count if high is None else min(count, int(np.floor((high - origin) / spacing + 0.5)) + 1)
+    if stop - start < 2:
+        last = origin + spacing * (count - 1)
+        raise InputError(f"the {name} range {bound} holds fewer than two samples (the data span {origin:g} to {last:g} m)")
+    return start, stop

@@ -82,3 +82,19 @@ def format_si(value, unit, digits=5):
     magnitude = abs(value)
     scale, prefix = next(((s, p) for s, p in _PREFIXES if magnitude >= s * 0.9999995), _PREFIXES[-1])
     return f"{value / scale:.{digits}g} {prefix}{unit}"
+
+
+def format_quantity(value, unit, digits=5):
+    """A number with its unit for people: ``unit`` is ``m`` (SI prefix chosen),
+    ``1/m`` (printed per mm), ``1`` (a pure number), ``%`` or ``deg``."""
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return "undefined"
+    if unit == "m":
+        return format_length(value, digits)
+    if unit == "1/m":
+        return f"{value * 1e-3:.{digits}g} /mm"
+    if unit == "%":
+        return f"{value:.{digits}g} %"
+    if unit == "deg":
+        return f"{value:.{digits}g}°"
+    return f"{value:.{digits}g}"

@@ -19,6 +19,8 @@ from .. import __version__
 COMMANDS = {
     "info": "rough.cli.info:info",
     "convert": "rough.cli.convert:convert",
+    "detrend": "rough.cli.detrend:detrend",
+    "features": "rough.cli.features:features",
 }
 
 log = logging.getLogger("rough")

@@ -46,7 +46,43 @@ class SpacingType(LengthType):
         return tuple(parts)
 
 
+class CropType(click.ParamType):
+    """``X0:X1`` or ``X0:X1,Y0:Y1`` (lengths; an empty end is open) → ((x0, x1), (y0, y1) or None)."""
+
+    name = "X0:X1[,Y0:Y1]"
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, tuple):
+            return value
+        ranges = []
+        for part in str(value).split(","):
+            ends = part.split(":")
+            if len(ends) != 2:
+                self.fail(f"{value!r}: write a range as X0:X1, e.g. 468um:733um (an empty end is open)", param, ctx)
+            ranges.append(tuple(None if not end.strip() else LENGTH.convert(end, param, ctx) for end in ends))
+        if len(ranges) > 2:
+            self.fail(f"{value!r}: at most two ranges, X0:X1,Y0:Y1", param, ctx)
+        return (ranges + [None])[:2]
+
+
+LENGTH = LengthType()
 SPACING = SpacingType()
+CROP = CropType()
+
+
+def crop_option(command):
+    """``--crop X0:X1[,Y0:Y1]``: select the evaluation range before anything else
+    happens. The range includes the samples nearest to its ends."""
+
+    @functools.wraps(command)
+    def wrapper(*args, surface, crop, **kwargs):
+        if crop is not None:
+            if crop[1] is not None and surface.is_profile:
+                raise click.BadParameter("a profile has no y range; give X0:X1", param_hint="--crop")
+            surface = surface.crop(*crop)
+        return command(*args, surface=surface, **kwargs)
+
+    return click.option("--crop", type=CROP, help="Evaluate only X0:X1 (and Y0:Y1 for maps), e.g. 468um:733um; positions include the origin.")(wrapper)
 
 
 def surface_input(command):

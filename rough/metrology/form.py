@@ -1,0 +1,72 @@
+"""Form removal: the least-squares polynomial of order N (SPEC §7; the slides remove
+``Y(x) = a0 + a1 x + a2 x²``).
+
+Profiles: a polynomial of degree N in x. Maps: all terms ``x^i y^j`` with
+``i + j ≤ N``. The fit uses the valid (non-NaN) points only; invalid points stay NaN
+in the result. Coordinates are centred and scaled to [-1, 1] and the basis is
+Legendre polynomials, which are nearly orthogonal on a regular grid, so the normal
+equations stay well conditioned at high orders. The basis is separable, so the
+normal equations are assembled from one pass over the map per product of x-basis
+functions, without ever forming the (points × terms) design matrix.
+"""
+
+import numpy as np
+from numpy.polynomial import legendre
+
+from ..errors import InputError
+
+
+def polynomial_form(surface, order=2):
+    """The least-squares polynomial of total degree ``order`` fitted to the valid
+    points of ``surface``, evaluated everywhere (an array shaped like the heights).
+
+    Raises InputError when the valid points cannot determine that many terms.
+    """
+    if order < 0:
+        raise InputError(f"the polynomial order must be 0 or more, not {order}")
+    heights = np.atleast_2d(surface.heights)
+    valid = ~np.isnan(heights)
+    ny, nx = heights.shape
+    along_x = legendre.legvander(_unit_interval(nx), order)
+    along_y = legendre.legvander(_unit_interval(ny), order if surface.heights.ndim == 2 else 0)
+    terms = [(i, j) for j in range(along_y.shape[1]) for i in range(order + 1 - j)]
+    weights = valid.astype(np.float64)
+    weighted_x = {(i, k): weights @ (along_x[:, i] * along_x[:, k]) for i in range(order + 1) for k in range(i, order + 1)}
+    projected = np.where(valid, heights, 0.0) @ along_x
+    gram = np.empty((len(terms), len(terms)))
+    right = np.empty(len(terms))
+    for a, (i, j) in enumerate(terms):
+        right[a] = along_y[:, j] @ projected[:, i]
+        for b, (k, l) in enumerate(terms):
+            gram[a, b] = (along_y[:, j] * along_y[:, l]) @ weighted_x[min(i, k), max(i, k)]
+    _check_determined(gram, valid, order, surface.heights.ndim)
+    coefficients = np.zeros((along_y.shape[1], order + 1))
+    for (i, j), value in zip(terms, np.linalg.solve(gram, right)):
+        coefficients[j, i] = value
+    return (along_y @ coefficients @ along_x.T).reshape(surface.heights.shape)
+
+
+def remove_form(surface, order=2):
+    """``surface`` minus its least-squares polynomial form of degree ``order``,
+    fitted on the valid points; NaN stays NaN. Appends a ``detrend`` history entry."""
+    residual = surface.heights - polynomial_form(surface, order)
+    return surface.derive("detrend", {"order": order}, heights=residual)
+
+
+def _unit_interval(n):
+    """n equally spaced coordinates mapped onto [-1, 1]."""
+    return np.linspace(-1.0, 1.0, n) if n > 1 else np.zeros(1)
+
+
+def _check_determined(gram, valid, order, ndim):
+    count = int(valid.sum())
+    if count == 0:
+        raise InputError("no valid points: nothing to fit")
+    scale = np.abs(np.diag(gram)).max()
+    smallest = np.linalg.eigvalsh(gram).min() if scale > 0 else 0.0
+    if smallest <= 1e-12 * scale:
+        shape = "distinct x positions" if ndim == 1 else "valid points spread over enough rows and columns"
+        raise InputError(
+            f"a polynomial of order {order} needs {order + 1} {shape}; the {count} valid points do not determine it "
+            "(use a lower --order)"
+        )

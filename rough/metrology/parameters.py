@@ -1,0 +1,318 @@
+"""ISO 4287/4288 profile parameters and ISO 25178-2 areal parameters.
+
+Everything is computed on the data as given, about the mean of the valid points
+(no levelling, no filter: detrend or filter first if you want them), over the
+valid (non-NaN) points only:
+
+- amplitude parameters (Ra, Rq, Rsk, Rku, Rt; Sa, Sq, Ssk, Sku, Sp, Sv, Sz) use the
+  valid points, so a scan with dropouts gives the values of its valid points;
+- slopes use pairs of neighbouring valid points; by default forward differences
+  (``slope="2point"``, the definition of SurfaceTopography's ``rms_gradient`` and
+  surfalize's Rdq), or ISO 4287's seven-point derivative (``slope="7point"``);
+- Rp, Rv and Rz are taken in each of ``sampling_lengths`` equal sampling lengths and
+  averaged over them (ISO 4287/4288; Rz is Rp + Rv, not the old ten-point Rz); Rku is
+  the kurtosis (3 for a Gaussian), not the excess;
+- RSm is the mean width of the profile elements between upward mean-line
+  crossings, with ISO 4287's discrimination (peaks and valleys of at least 10 % of
+  Rz, applied as a hysteresis band; elements of at least 1 % of the sampling length);
+- peak density counts the peaks that cross a band of ±5 % of Rz about the mean line
+  (``peak_band``; ISO 4287/Amd.1's RPc rule: a peak counts when the profile rises
+  above the band after being below it), per metre of evaluation length;
+- Z2 is Tse & Cruden's RMS first derivative of the profile sampled at
+  ``jrc_spacing`` (0.5 mm by default), and JRC = 32.2 + 32.47 log10(Z2);
+- Sal and Str come from the autocorrelation function computed over pairs of valid
+  points only (no filling), Std from the Hann-windowed power spectrum; Std is the
+  direction of the lay (the ridges), counter-clockwise from +x, in [0°, 180°).
+"""
+
+import logging
+import math
+
+import numpy as np
+
+from ..errors import InputError
+
+log = logging.getLogger("rough")
+
+SLOPES = ("2point", "7point")
+SEVEN_POINT = np.array([1.0, -9.0, 45.0, 0.0, -45.0, 9.0, -1.0]) / 60.0
+
+# key: (unit, what it is). Units: "m", "1/m", "1" (dimensionless), "%", "deg".
+PROFILE = {
+    "Ra": ("m", "arithmetic mean deviation"),
+    "Rq": ("m", "root mean square deviation"),
+    "Rsk": ("1", "skewness"),
+    "Rku": ("1", "kurtosis (3 for a Gaussian)"),
+    "Rp": ("m", "maximum peak height, mean over sampling lengths"),
+    "Rv": ("m", "maximum valley depth, mean over sampling lengths"),
+    "Rz": ("m", "maximum height Rp + Rv, mean over sampling lengths"),
+    "Rt": ("m", "total height over the evaluation length"),
+    "RSm": ("m", "mean width of the profile elements"),
+    "Rdq": ("1", "root mean square slope"),
+    "peak_density": ("1/m", "peaks crossing a ±5 % Rz band about the mean line, per length"),
+    "Z2": ("1", "Tse & Cruden RMS first derivative at the JRC spacing"),
+    "JRC": ("1", "joint roughness coefficient, 32.2 + 32.47 log10(Z2)"),
+}
+AREAL = {
+    "Sa": ("m", "arithmetic mean height"),
+    "Sq": ("m", "root mean square height"),
+    "Ssk": ("1", "skewness"),
+    "Sku": ("1", "kurtosis (3 for a Gaussian)"),
+    "Sp": ("m", "maximum peak height"),
+    "Sv": ("m", "maximum pit depth"),
+    "Sz": ("m", "maximum height Sp + Sv"),
+    "Sdq": ("1", "root mean square gradient"),
+    "Sdr": ("%", "developed interfacial area ratio"),
+    "Sal": ("m", "autocorrelation length (ACF decays to 0.2)"),
+    "Str": ("1", "texture aspect ratio (1 isotropic, → 0 directional)"),
+    "Std": ("deg", "texture (lay) direction from +x"),
+}
+
+
+def amplitude(values):
+    """Mean-removed moments of a 1-D array of valid heights: Ra, Rq, Rsk, Rku, and
+    the height range (max, min) about the mean."""
+    if values.size == 0:
+        raise InputError("no valid points: nothing to evaluate")
+    centred = values - values.mean()
+    squared = centred * centred
+    rq = math.sqrt(squared.mean())
+    skew = float(np.mean(squared * centred)) / rq**3 if rq > 0 else math.nan
+    kurtosis = float(np.mean(squared * squared)) / rq**4 if rq > 0 else math.nan
+    return {"a": float(np.abs(centred).mean()), "q": rq, "sk": skew, "ku": kurtosis,
+            "p": float(centred.max()), "v": float(-centred.min())}
+
+
+def slopes(heights, spacing, method="2point", axis=-1):
+    """Local slopes dz/dx along ``axis`` (NaN where a point needed is invalid):
+    forward differences, or ISO 4287's seven-point formula on interior points."""
+    if method not in SLOPES:
+        raise InputError(f"slope method must be one of {', '.join(SLOPES)}, not {method!r}")
+    if method == "2point":
+        return np.diff(heights, axis=axis) / spacing
+    from scipy.ndimage import correlate1d
+
+    if heights.shape[axis] < 7:
+        raise InputError("the seven-point slope needs at least 7 points along each axis")
+    derivative = correlate1d(heights, SEVEN_POINT[::-1], axis=axis, mode="constant", cval=np.nan) / spacing
+    return np.take(derivative, range(3, heights.shape[axis] - 3), axis=axis)
+
+
+def profile_parameters(surface, sampling_lengths=5, slope="2point", jrc_spacing=0.5e-3, peak_band=0.05):
+    """ISO 4287 parameters of a profile (see the module text for the definitions).
+    Returns a dict of floats in SI units keyed as ``PROFILE``."""
+    z = surface.heights
+    dx = surface.spacing[0]
+    valid = ~np.isnan(z)
+    centred = z - np.nanmean(z) if valid.any() else z
+    moments = amplitude(z[valid])
+    rp, rv = _per_sampling_length(centred, sampling_lengths)
+    rz = rp + rv
+    length = z.size * dx
+    slope_values = slopes(z, dx, slope)
+    z2 = _z2(surface, jrc_spacing)
+    return {
+        "Ra": moments["a"], "Rq": moments["q"], "Rsk": moments["sk"], "Rku": moments["ku"],
+        "Rp": rp, "Rv": rv, "Rz": rz, "Rt": moments["p"] + moments["v"],
+        "RSm": mean_element_width(centred, dx, rz, length / sampling_lengths),
+        "Rdq": _rms(slope_values),
+        "peak_density": peak_count(centred, peak_band * rz) / length,
+        "Z2": z2,
+        "JRC": 32.2 + 32.47 * math.log10(z2) if z2 > 0 else math.nan,
+    }
+
+
+def areal_parameters(surface, slope="2point", threshold=0.2):
+    """ISO 25178-2 parameters of a map (see the module text for the definitions).
+    Returns a dict of floats in SI units keyed as ``AREAL``."""
+    z = surface.heights
+    dx, dy = surface.spacing
+    valid = ~np.isnan(z)
+    moments = amplitude(z[valid])
+    gx, gy = slopes(z, dx, slope, axis=1), slopes(z, dy, slope, axis=0)
+    if slope == "2point":
+        gx, gy = gx[:-1, :], gy[:, :-1]
+    squared = gx**2 + gy**2
+    sal, str_ratio = autocorrelation_lengths(surface, threshold)
+    return {
+        "Sa": moments["a"], "Sq": moments["q"], "Ssk": moments["sk"], "Sku": moments["ku"],
+        "Sp": moments["p"], "Sv": moments["v"], "Sz": moments["p"] + moments["v"],
+        "Sdq": float(math.sqrt(np.nanmean(squared))) if np.isfinite(squared).any() else math.nan,
+        "Sdr": float(100.0 * np.nanmean(np.sqrt(1.0 + squared) - 1.0)) if np.isfinite(squared).any() else math.nan,
+        "Sal": sal,
+        "Str": str_ratio,
+        "Std": texture_direction(surface),
+    }
+
+
+def amplitude_density(surface, bins=50):
+    """The amplitude probability density of the valid heights about their mean:
+    ``(bin centres in m, density in 1/m)``."""
+    values = surface.heights[~np.isnan(surface.heights)]
+    density, edges = np.histogram(values - values.mean(), bins=bins, density=True)
+    return (edges[:-1] + edges[1:]) / 2, density
+
+
+def _rms(values):
+    finite = values[np.isfinite(values)]
+    return float(math.sqrt(np.mean(finite**2))) if finite.size else math.nan
+
+
+def _per_sampling_length(centred, count):
+    """Rp and Rv in each of ``count`` equal sampling lengths, averaged."""
+    if count < 1 or count > centred.size // 2:
+        raise InputError(f"cannot split {centred.size} points into {count} sampling lengths")
+    peaks, valleys = [], []
+    for part in np.array_split(centred, count):
+        part = part[~np.isnan(part)]
+        if part.size:
+            peaks.append(part.max())
+            valleys.append(-part.min())
+    return float(np.mean(peaks)), float(np.mean(valleys))
+
+
+def mean_element_width(centred, spacing, rz, sampling_length):
+    """RSm: the mean width of the profile elements, each a peak and the valley after
+    it, from one upward crossing of the mean line to the next. ISO 4287's height
+    discrimination (a peak must rise 10 % of Rz above the mean line and a valley
+    fall as far below) is applied as a hysteresis band: only the upward crossing
+    between a dip below -10 % Rz and a rise above +10 % Rz bounds an element. Then
+    elements narrower than 1 % of the sampling length merge with the next. NaN gaps
+    are closed up; NaN when there is no complete element."""
+    values = centred[~np.isnan(centred)]
+    band = 0.1 * rz
+    side = np.where(values > band, 1, np.where(values < -band, -1, 0))
+    marked = np.flatnonzero(side)
+    rises = marked[1:][(side[marked][:-1] < 0) & (side[marked][1:] > 0)]
+    if rises.size < 2:
+        return math.nan
+    index = np.arange(values.size)
+    last_below = np.maximum.accumulate(np.where(values <= 0, index, -1))[rises]
+    crossings = last_below + values[last_below] / (values[last_below] - values[last_below + 1])
+    kept = [crossings[0]]
+    for crossing in crossings[1:]:
+        if (crossing - kept[-1]) * spacing >= 0.01 * sampling_length:
+            kept.append(crossing)
+    return float(np.mean(np.diff(kept)) * spacing) if len(kept) > 1 else math.nan
+
+
+def peak_count(centred, band):
+    """Peaks that cross a band of ±``band`` about the mean line (ISO 4287/Amd.1 RPc):
+    a peak counts each time the profile rises above +band after being below -band.
+    NaN points are skipped."""
+    values = centred[~np.isnan(centred)]
+    side = np.sign(values) * (np.abs(values) > band)
+    side = side[side != 0]
+    return int(np.count_nonzero((side[:-1] < 0) & (side[1:] > 0)))
+
+
+def _z2(surface, jrc_spacing):
+    """Z2 of the profile point-sampled every ``jrc_spacing`` (linear interpolation
+    between valid points; the data spacing when that is coarser)."""
+    dx = surface.spacing[0]
+    x = surface.positions(0)
+    valid = ~np.isnan(surface.heights)
+    step = max(jrc_spacing, dx)
+    samples = np.arange(x[valid][0], x[valid][-1] + dx / 2, step) if valid.sum() > 1 else np.array([])
+    if samples.size < 3:
+        return math.nan
+    heights = np.interp(samples, x[valid], surface.heights[valid])
+    return float(math.sqrt(np.mean(np.diff(heights) ** 2)) / step)
+
+
+def autocorrelation(surface):
+    """The normalised autocorrelation of the mean-removed valid heights, over pairs
+    of valid points only, on lags up to half the map in each direction: returns
+    ``(acf, lag_x, lag_y)`` with ``acf[j, i]`` at lag ``(lag_x[i], lag_y[j])``."""
+    from scipy import fft
+
+    z = surface.heights
+    valid = ~np.isnan(z)
+    centred = np.where(valid, z - z[valid].mean(), 0.0)
+    ny, nx = z.shape
+    shape = (fft.next_fast_len(ny + ny // 2 + 1, real=True), fft.next_fast_len(nx + nx // 2 + 1, real=True))
+    spectrum = fft.rfft2(centred, shape, workers=-1)
+    products = fft.irfft2(spectrum * spectrum.conj(), shape, workers=-1)
+    del spectrum
+    if valid.all():
+        pairs = np.outer(_overlap(ny, shape[0]), _overlap(nx, shape[1]))
+    else:
+        mask = fft.rfft2(valid.astype(np.float64), shape, workers=-1)
+        pairs = np.rint(fft.irfft2(mask * mask.conj(), shape, workers=-1))
+    hy, hx = ny // 2, nx // 2
+    rows = np.r_[shape[0] - hy: shape[0], 0: hy + 1]
+    columns = np.r_[shape[1] - hx: shape[1], 0: hx + 1]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        acf = products[np.ix_(rows, columns)] / pairs[np.ix_(rows, columns)]
+    acf = acf / acf[hy, hx]
+    return acf, np.arange(-hx, hx + 1) * surface.spacing[0], np.arange(-hy, hy + 1) * surface.spacing[1]
+
+
+def _overlap(n, padded):
+    """How many pairs of points of a full row of ``n`` lie at each circular lag."""
+    lags = np.arange(padded)
+    lags = np.where(lags <= padded // 2, lags, padded - lags)
+    return np.clip(n - lags, 0, None).astype(np.float64)
+
+
+def autocorrelation_lengths(surface, threshold=0.2, directions=360):
+    """Sal (the shortest lag at which the ACF falls to ``threshold``) and Str (Sal over
+    the longest such decay length among all directions). Lags reach half the map
+    along each axis; Str is NaN when the ACF does not fall to ``threshold`` within
+    that in some direction (the texture is longer than half the map)."""
+    from scipy.ndimage import map_coordinates
+
+    acf, lag_x, lag_y = autocorrelation(surface)
+    dx, dy = surface.spacing
+    cy, cx = (acf.shape[0] - 1) / 2, (acf.shape[1] - 1) / 2
+    step = min(dx, dy) / 4
+    decay, reaches = np.full(directions, np.nan), np.empty(directions)
+    for k, angle in enumerate(np.linspace(0, np.pi, directions, endpoint=False)):
+        reach = reaches[k] = min(lag_x[-1] / max(abs(math.cos(angle)), 1e-12), lag_y[-1] / max(math.sin(angle), 1e-12))
+        radii = np.arange(0, reach + step / 2, step)
+        along = map_coordinates(acf, [cy + radii * math.sin(angle) / dy, cx + radii * math.cos(angle) / dx], order=1)
+        below = np.flatnonzero(along <= threshold)
+        if below.size:
+            i = below[0]
+            decay[k] = radii[i - 1] + (along[i - 1] - threshold) / (along[i - 1] - along[i]) * step
+    fastest = float(np.nanmin(decay)) if np.isfinite(decay).any() else math.nan
+    slowest = float(np.max(decay)) if np.isfinite(decay).all() else math.nan
+    if np.isnan(slowest) and np.isfinite(fastest):
+        log.warning("Str is undefined: the autocorrelation stays above %g out to half the map in some direction "
+                    "(the texture runs longer than that); Str < %.3g", threshold, fastest / np.max(reaches[np.isnan(decay)]))
+    return fastest, fastest / slowest if slowest > 0 else math.nan
+
+
+def angular_spectrum(surface, directions=360):
+    """The angular power spectrum of the mean-removed map (Hann-windowed, NaN points
+    set to the mean): ``(wavevector angles in degrees, power)``, integrating
+    ``|F|²`` along each radius as ISO 25178-2 does, up to the smaller Nyquist
+    frequency and leaving out the lowest two frequencies."""
+    from scipy import fft
+    from scipy.ndimage import map_coordinates
+
+    z = surface.heights
+    valid = ~np.isnan(z)
+    window = np.outer(np.hanning(z.shape[0]), np.hanning(z.shape[1]))
+    transform = fft.rfft2(np.where(valid, z - z[valid].mean(), 0.0) * window, workers=-1)
+    power = fft.fftshift(transform.real**2 + transform.imag**2, axes=0)
+    ny, nx = z.shape
+    dfx, dfy = 1 / (nx * surface.spacing[0]), 1 / (ny * surface.spacing[1])
+    nyquist = min(0.5 / surface.spacing[0], 0.5 / surface.spacing[1])
+    step = min(dfx, dfy)
+    radii = np.arange(2 * step, nyquist, step)
+    angles = np.linspace(0, 180, directions, endpoint=False)
+    spectrum = np.empty(directions)
+    for k, angle in enumerate(np.radians(angles)):
+        fx, fy = radii * math.cos(angle), radii * math.sin(angle)
+        flip = np.where(fx < 0, -1.0, 1.0)  # |F(-f)| = |F(f)|: fold onto the kx ≥ 0 half plane
+        coordinates = [ny // 2 + flip * fy / dfy, flip * fx / dfx]
+        spectrum[k] = map_coordinates(power, coordinates, order=1).sum() * step
+    return angles, spectrum
+
+
+def texture_direction(surface):
+    """Std: the lay direction, perpendicular to the wavevector of the largest
+    angular power, in degrees counter-clockwise from +x, in [0, 180)."""
+    angles, spectrum = angular_spectrum(surface)
+    return float((angles[np.argmax(spectrum)] + 90.0) % 180.0)

@@ -1,0 +1,65 @@
+"""Figures that the commands draw with ``--plot FILE`` (matplotlib, no display
+needed). Each function returns a matplotlib Figure; :func:`save` writes one
+atomically in the format of the file's extension (png, pdf, svg, ...)."""
+
+import os
+
+import numpy as np
+
+MM = 1e3
+UM = 1e6
+
+
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg", force=True)
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def save(figure, path):
+    """Write ``figure`` to ``path`` (atomically) and close it."""
+    from .io.atomic import atomic_output
+
+    extension = os.path.splitext(os.fspath(path))[1].lstrip(".").lower() or "png"
+    try:
+        with atomic_output(path) as stream:
+            figure.savefig(stream, format=extension, dpi=150, bbox_inches="tight")
+    finally:
+        _pyplot().close(figure)
+
+
+def features_figure(surface, features=(), density=None):
+    """A profile with its detected features shaded, or a map in false colour; and the
+    amplitude probability density of the heights with the Gaussian of the same Rq."""
+    plt = _pyplot()
+    figure, (top, bottom) = plt.subplots(2, 1, figsize=(8, 6.5), gridspec_kw={"height_ratios": [1.3, 1]})
+    heights = surface.heights - np.nanmean(surface.heights)
+    if surface.is_profile:
+        top.plot(surface.positions(0) * MM, heights * UM, lw=0.7, color="0.2")
+        for feature in features:
+            top.axvspan(feature.start * MM, feature.end * MM, color="tab:red" if feature.kind == "peak" else "tab:blue", alpha=0.2)
+        top.set_xlabel("x (mm)")
+        top.set_ylabel("height (µm)")
+        top.set_title(f"{surface.metadata.get('title', 'profile')}: {len(features)} features shaded")
+    else:
+        x, y = surface.positions(0) * MM, surface.positions(1) * MM
+        image = top.imshow(heights * UM, extent=(x[0], x[-1], y[-1], y[0]), cmap="viridis", aspect="equal")
+        figure.colorbar(image, ax=top, label="height (µm)")
+        top.set_xlabel("x (mm)")
+        top.set_ylabel("y (mm)")
+    if density is not None:
+        centres, values = density
+        width = centres[1] - centres[0] if len(centres) > 1 else 1.0
+        bottom.bar(centres * UM, values / UM, width=width * UM, color="0.7", label="amplitude density")
+        rq = np.sqrt(np.nanmean(heights**2))
+        grid = np.linspace(centres[0], centres[-1], 400)
+        gaussian = np.exp(-0.5 * (grid / rq) ** 2) / (rq * np.sqrt(2 * np.pi))
+        bottom.plot(grid * UM, gaussian / UM, color="tab:orange", label=f"Gaussian, same Rq ({rq * UM:.4g} µm)")
+        bottom.set_xlabel("height about the mean (µm)")
+        bottom.set_ylabel("probability density (1/µm)")
+        bottom.legend(fontsize="small")
+    figure.tight_layout()
+    return figure
