@@ -51,8 +51,8 @@ def features(surface, input, cutoff, ends, sampling_lengths, slope, jrc_spacing,
     from .. import metrology
     from ..io.atomic import atomic_output
 
-    values = metrology.parameters(surface, cutoff, ends, sampling_lengths, slope, along, jrc_spacing)
     evaluated = surface if cutoff is None else metrology.split(surface, cutoff, "roughness", ends)
+    values = metrology.parameters(evaluated, None, ends, sampling_lengths, slope, along, jrc_spacing)
     table = metrology.PROFILE if surface.is_profile or along else metrology.AREAL
     rows, document = _parameter_rows(evaluated, values, table, cutoff, sampling_lengths, slope, jrc_spacing, along)
     found = []

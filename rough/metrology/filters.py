@@ -18,6 +18,7 @@ Ends: ``ends="trim"`` (the default) drops λc/2 at each end, the region where IS
 with the renormalised kernel.
 """
 
+import dataclasses
 import math
 
 import numpy as np
@@ -81,15 +82,13 @@ def split(surface, cutoff, keep="roughness", ends="trim"):
                                          "cutoff": cutoff, "keep": keep, "ends": ends}, heights=result)
     if ends == "correct":
         return filtered
-    margin = [int(np.ceil(cutoff / 2 / d - 1e-9)) for d in filtered.spacing]
-    bounds = [(o + m * d, o + (n - 1 - m) * d) for o, m, d, n in zip(filtered.origin, margin, filtered.spacing, filtered.points)]
-    for (low, high), name in zip(bounds, "xy"):
-        if high - low <= 0:
-            raise InputError(f"the data are too short in {name} for a cut-off of {format_length(cutoff)} once λc/2 is trimmed "
-                             "at each end (use --ends correct or a shorter cut-off)")
-    trimmed = filtered.crop(*bounds)
-    trimmed.history = filtered.history
-    return trimmed
+    margins = [int(np.ceil(cutoff / 2 / d - 1e-9)) for d in filtered.spacing]
+    if any(n - 2 * m < 2 for n, m in zip(filtered.points, margins)):
+        raise InputError(f"the data are too short for a cut-off of {format_length(cutoff)} once λc/2 is trimmed "
+                         "at each end (use --ends correct or a shorter cut-off)")
+    index = tuple(slice(m, n - m) for n, m in zip(reversed(filtered.points), reversed(margins)))
+    origin = tuple(o + m * d for o, m, d in zip(filtered.origin, margins, filtered.spacing))
+    return dataclasses.replace(filtered, heights=filtered.heights[index], origin=origin)
 
 
 def _check_cutoff(surface, cutoff):
