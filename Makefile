@@ -32,6 +32,12 @@ demo: $(BIN)/.installed
 	@echo
 	@echo '$$ rough features sample_profiles/rock-map.x3p'
 	@$(BIN)/rough features sample_profiles/rock-map.x3p
+	@echo
+	@echo '$$ rough fit-fractal --plot $(DEMO)/psd.png sample_profiles/rock-profile.tsv'
+	@$(BIN)/rough fit-fractal --plot $(DEMO)/psd.png sample_profiles/rock-profile.tsv
+	@echo
+	@echo '$$ rough synth --length 80mm --dimension 1.275 --rq 0.2781mm --seed 1 | rough resample --spacing 0.1545mm | rough fit-fractal'
+	@$(BIN)/rough synth --length 80mm --dimension 1.275 --rq 0.2781mm --seed 1 | $(BIN)/rough resample --spacing 0.1545mm | $(BIN)/rough fit-fractal
 
 test: $(BIN)/.installed
 	$(BIN)/python -m pytest -q
@@ -39,6 +45,7 @@ test: $(BIN)/.installed
 bench: $(BIN)/.installed
 	$(BIN)/python bench/bench_io.py
 	$(BIN)/python bench/bench_metrology.py
+	$(BIN)/python bench/bench_fractal.py
 
 clean:
 	rm -rf build $(VENV) *.egg-info .pytest_cache .hypothesis

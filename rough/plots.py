@@ -63,3 +63,23 @@ def features_figure(surface, features=(), density=None):
         bottom.legend(fontsize="small")
     figure.tight_layout()
     return figure
+
+
+def spectrum_figure(frequencies, density, fit, title="power spectrum"):
+    """The binned spectrum on log-log axes with the fitted power law over its band
+    (profiles: G in m³; maps: the ring-averaged P2 in m⁴)."""
+    plt = _pyplot()
+    figure, axes = plt.subplots(figsize=(7, 5))
+    axes.loglog(frequencies * 1e-3, density, "o", ms=3.5, color="0.35", label="binned periodogram")
+    low, high = fit.band
+    grid = np.geomspace(low, high, 100)
+    exponent = 5 - 2 * fit.fractal_dimension if fit.profile_dimension is None else 8 - 2 * fit.fractal_dimension
+    axes.loglog(grid * 1e-3, fit.psd_prefactor * grid**-exponent, color="tab:red", lw=2,
+                label=f"fit: {'D' if fit.profile_dimension is None else 'Ds'} = {fit.fractal_dimension:.4f} ± {fit.fractal_dimension_stderr:.4f}")
+    axes.axvspan(low * 1e-3, high * 1e-3, color="tab:red", alpha=0.06, label="fit band")
+    axes.set_xlabel("spatial frequency (1/mm)")
+    axes.set_ylabel("PSD G(f) (m³)" if fit.profile_dimension is None else "ring-averaged P2 (m⁴)")
+    axes.set_title(title)
+    axes.legend(fontsize="small")
+    figure.tight_layout()
+    return figure

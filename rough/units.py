@@ -98,3 +98,18 @@ def format_quantity(value, unit, digits=5):
     if unit == "deg":
         return f"{value:.{digits}g}°"
     return f"{value:.{digits}g}"
+
+
+_FREQUENCY = re.compile(r"^\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)\s*(?:(?:1?/|per\s*)\s*([^\s\d.+-][^\s]*))?\s*$")
+
+
+def parse_frequency(text, default_unit="mm"):
+    """A spatial frequency in cycles per length: ``'0.2/mm'``, ``'200/m'``, ``'5 per um'``
+    → 1/m. A bare number is per ``default_unit``."""
+    match = _FREQUENCY.match(str(text))
+    if not match:
+        raise InputError(f"{text!r} is not a spatial frequency (write e.g. 0.2/mm or 200/m)")
+    value = float(match.group(1)) / metres_per(match.group(2) or default_unit)
+    if not math.isfinite(value) or value < 0:
+        raise InputError(f"{text!r} is not a usable spatial frequency")
+    return value

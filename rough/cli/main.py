@@ -21,6 +21,9 @@ COMMANDS = {
     "convert": "rough.cli.convert:convert",
     "detrend": "rough.cli.detrend:detrend",
     "features": "rough.cli.features:features",
+    "synth": "rough.cli.synth:synth",
+    "fit-fractal": "rough.cli.fit_fractal:fit_fractal",
+    "resample": "rough.cli.resample:resample",
 }
 
 log = logging.getLogger("rough")

@@ -1,7 +1,8 @@
 """Options shared by the subcommands, as decorators (in the manner of rasterio's rio).
 
 ``surface_input`` adds INPUT (default ``-``) and the read options and hands the
-command a :class:`~rough.Surface`; ``surface_output`` adds ``-o/--output`` and
+command a :class:`~rough.Surface` (``input_options(flag)`` names the input-spacing
+option otherwise, for commands whose own ``--spacing`` is an output); ``surface_output`` adds ``-o/--output`` and
 ``-f/--format`` and hands it an :class:`Output` that writes a surface there; ``report_format``
 adds ``--json``/``--tsv``. Lengths take a unit; a bare number is in mm.
 """
@@ -65,9 +66,31 @@ class CropType(click.ParamType):
         return (ranges + [None])[:2]
 
 
+class FrequencyRangeType(click.ParamType):
+    """``FMIN:FMAX`` spatial frequencies (``0.1/mm:20/mm``; a bare number is per mm;
+    an empty end is open) → (fmin or None, fmax or None) in 1/m."""
+
+    name = "FMIN:FMAX"
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, tuple):
+            return value
+        from ..errors import InputError
+        from ..units import parse_frequency
+
+        ends = str(value).split(":")
+        if len(ends) != 2:
+            self.fail(f"{value!r}: write a band as FMIN:FMAX, e.g. 0.1/mm:20/mm", param, ctx)
+        try:
+            return tuple(None if not end.strip() else parse_frequency(end) for end in ends)
+        except InputError as error:
+            self.fail(str(error), param, ctx)
+
+
 LENGTH = LengthType()
 SPACING = SpacingType()
 CROP = CropType()
+BAND = FrequencyRangeType()
 
 
 def crop_option(command):
@@ -85,26 +108,33 @@ def crop_option(command):
     return click.option("--crop", type=CROP, help="Evaluate only X0:X1 (and Y0:Y1 for maps), e.g. 468um:733um; positions include the origin.")(wrapper)
 
 
-def surface_input(command):
-    """INPUT plus ``--spacing``, ``--unit`` and ``--ignore-checksums``; the command
-    receives ``surface`` (the surface read) and ``input`` (the name given)."""
+def input_options(spacing_flag="--spacing"):
+    """INPUT plus ``--spacing`` (under ``spacing_flag``), ``--unit`` and
+    ``--ignore-checksums``; the command receives ``surface`` (the surface read) and
+    ``input`` (the name given)."""
 
-    @functools.wraps(command)
-    def wrapper(*args, input, spacing, unit, ignore_checksums, **kwargs):
-        from ..io import read
+    def decorate(command):
+        @functools.wraps(command)
+        def wrapper(*args, input, spacing, unit, ignore_checksums, **kwargs):
+            from ..io import read
 
-        surface = read(input, spacing=spacing, unit=unit, verify=not ignore_checksums)
-        return command(*args, surface=surface, input=input, **kwargs)
+            surface = read(input, spacing=spacing, unit=unit, verify=not ignore_checksums)
+            return command(*args, surface=surface, input=input, **kwargs)
 
-    decorators = [
-        click.argument("input", default="-", metavar="[INPUT]"),
-        click.option("--spacing", type=SPACING, help="Spacing of data that carry none (NPY, a column of heights), e.g. 1um or 1um,2um; overrides a file's own."),
-        click.option("--unit", metavar="UNIT", help="Length unit of text values that name none (default m)."),
-        click.option("--ignore-checksums", is_flag=True, help="Read X3P files whose MD5 checksums fail, with a warning."),
-    ]
-    for decorator in reversed(decorators):
-        wrapper = decorator(wrapper)
-    return wrapper
+        decorators = [
+            click.argument("input", default="-", metavar="[INPUT]"),
+            click.option(spacing_flag, "spacing", type=SPACING, help="Spacing of input data that carry none (NPY, a column of heights), e.g. 1um or 1um,2um; overrides a file's own."),
+            click.option("--unit", metavar="UNIT", help="Length unit of text values that name none (default m)."),
+            click.option("--ignore-checksums", is_flag=True, help="Read X3P files whose MD5 checksums fail, with a warning."),
+        ]
+        for decorator in reversed(decorators):
+            wrapper = decorator(wrapper)
+        return wrapper
+
+    return decorate
+
+
+surface_input = input_options()
 
 
 def surface_output(command):

@@ -22,6 +22,15 @@ def polynomial_form(surface, order=2):
 
     Raises InputError when the valid points cannot determine that many terms.
     """
+    along_y, coefficients, along_x = form_factors(surface, order)
+    return (along_y @ coefficients @ along_x.T).reshape(surface.heights.shape)
+
+
+def form_factors(surface, order=2):
+    """The fitted form as separable factors ``(Y, K, X)`` with form = Y @ K @ X.T:
+    Y (ny × terms in y) and X (nx × terms in x) are Legendre bases on the rows and
+    columns, K the coefficients. For a profile Y is [[1]]. Lets callers evaluate the
+    form a block of rows at a time."""
     if order < 0:
         raise InputError(f"the polynomial order must be 0 or more, not {order}")
     heights = np.atleast_2d(surface.heights)
@@ -30,9 +39,13 @@ def polynomial_form(surface, order=2):
     along_x = legendre.legvander(_unit_interval(nx), order)
     along_y = legendre.legvander(_unit_interval(ny), order if surface.heights.ndim == 2 else 0)
     terms = [(i, j) for j in range(along_y.shape[1]) for i in range(order + 1 - j)]
-    weights = valid.astype(np.float64)
-    weighted_x = {(i, k): weights @ (along_x[:, i] * along_x[:, k]) for i in range(order + 1) for k in range(i, order + 1)}
-    projected = np.where(valid, heights, 0.0) @ along_x
+    complete = bool(valid.all())
+    weights = None if complete else valid.astype(np.float64)
+    weighted_x = {
+        (i, k): np.full(ny, along_x[:, i] @ along_x[:, k]) if complete else weights @ (along_x[:, i] * along_x[:, k])
+        for i in range(order + 1) for k in range(i, order + 1)
+    }
+    projected = (heights if complete else np.where(valid, heights, 0.0)) @ along_x
     gram = np.empty((len(terms), len(terms)))
     right = np.empty(len(terms))
     for a, (i, j) in enumerate(terms):
@@ -43,7 +56,7 @@ def polynomial_form(surface, order=2):
     coefficients = np.zeros((along_y.shape[1], order + 1))
     for (i, j), value in zip(terms, np.linalg.solve(gram, right)):
         coefficients[j, i] = value
-    return (along_y @ coefficients @ along_x.T).reshape(surface.heights.shape)
+    return along_y, coefficients, along_x
 
 
 def remove_form(surface, order=2):

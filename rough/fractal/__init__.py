@@ -1,0 +1,1 @@
+"""Fractal characterisation and synthesis: power-law spectra, D and C."""

@@ -1,0 +1,216 @@
+"""Power spectra: the normalised periodogram, log binning, and conversions between
+spectral conventions (SPEC §6).
+
+rough's canonical profile PSD is one-sided in cycles per metre, ``Rq² = ∫ G(f) df``:
+``G_k = 2 Δx |Z_k|² / (N U)`` for 0 < k < N/2 (DC and Nyquist not doubled), with Z the
+DFT of the windowed heights and U = mean(w²) the window's power, so that
+``Σ G_k Δf = mean((w z)²) / U`` (Parseval). Maps use the two-sided
+``P2 = Δx Δy |Z|² / (Nx Ny U)``, ``Sq² = ∬ P2``.
+
+Other conventions of the same spectrum (all functions of frequency f in 1/m):
+- SurfaceTopography's ``C1D(q) = G(q/2π)/2`` at q = 2πf (Rq² = (1/π) ∫₀^∞ C1D dq);
+- Gwyddion's ``W1(k) = G(k/2π)/(2π)`` at k = 2πf (Rq² = ∫₀^∞ W1 dk);
+- Ganti & Bhushan's two-sided angular ``P(ω) = G(ω/2π)/(4π)`` (Rq² = ∫_-∞^∞ P dω).
+"""
+
+
+import numpy as np
+
+from ..errors import InputError
+
+WINDOWS = ("hann", "none")
+
+
+def periodogram(heights, spacing, window="hann"):
+    """``(f, G, parseval)`` of a gap-free profile: the one-sided periodogram at
+    f_k = k/(NΔx), k = 0 … N/2, and Σ G Δf divided by mean((w z)²)/U (1 to rounding)."""
+    if window not in WINDOWS:
+        raise InputError(f"window must be one of {', '.join(WINDOWS)}, not {window!r}")
+    n = heights.size
+    weights = np.hanning(n) if window == "hann" else np.ones(n)
+    power = np.mean(weights**2)
+    transform = np.fft.rfft(heights * weights)
+    density = 2.0 * spacing * np.abs(transform) ** 2 / (n * power)
+    density[0] /= 2.0
+    if n % 2 == 0:
+        density[-1] /= 2.0
+    frequencies = np.arange(density.size) / (n * spacing)
+    parseval = density.sum() / (n * spacing) / (np.mean((heights * weights) ** 2) / power)
+    return frequencies, density, float(parseval)
+
+
+def log_bins(frequencies, density, per_decade=10, minimum=1):
+    """Average ``density`` in logarithmic frequency bins (``per_decade`` per decade,
+    a bin merged with the next until it holds ``minimum`` ordinates), leaving out
+    f = 0. Frequencies must ascend. Returns ``(geometric mean frequency, mean
+    density, count)`` per bin."""
+    keep = frequencies > 0
+    f, g = frequencies[keep], density[keep]
+    decade_index = np.floor(np.log10(f) * per_decade + 1e-9).astype(int)
+    groups = np.split(np.arange(f.size), np.flatnonzero(np.diff(decade_index)) + 1)
+    bins, members = [], []
+    for group in groups:
+        members.extend(group)
+        if len(members) >= minimum:
+            bins.append(members)
+            members = []
+    if members:
+        if bins:
+            bins[-1].extend(members)
+        else:
+            bins.append(members)
+    centres = np.array([np.exp(np.mean(np.log(f[b]))) for b in bins])
+    return centres, np.array([g[b].mean() for b in bins]), np.array([len(b) for b in bins])
+
+
+def periodic_hann(n):
+    """The DFT-even Hann window 0.5 - 0.5 cos(2πj/n): in frequency it is exactly the
+    three-tap filter (-1/4, 1/2, -1/4), so its smoothing of a spectrum is known."""
+    return 0.5 - 0.5 * np.cos(2 * np.pi * np.arange(n) / n)
+
+
+def windowed_map(surface, order=1, rows_per_block=256):
+    """``(field, power)``: the map less its polynomial form of ``order``, times the 2-D
+    periodic Hann window, in float32 (computed a block of rows at a time, so no
+    full-size temporaries); ``power`` is the window's mean square."""
+    from ..metrology.form import form_factors
+
+    along_y, coefficients, along_x = form_factors(surface, order)
+    ny, nx = surface.heights.shape
+    window_y, window_x = periodic_hann(ny), periodic_hann(nx)
+    along_x_terms = coefficients @ along_x.T
+    field = np.empty((ny, nx), dtype=np.float32)
+    for start in range(0, ny, rows_per_block):
+        rows = slice(start, min(start + rows_per_block, ny))
+        field[rows] = (surface.heights[rows] - along_y[rows] @ along_x_terms) * window_y[rows, np.newaxis] * window_x
+    return field, float(np.mean(window_y**2) * np.mean(window_x**2))
+
+
+def ring_spectrum(field, power, spacing, low, high, step, sector=None, rows_per_block=256):
+    """The two-sided 2-D periodogram of a windowed map (see :func:`windowed_map`),
+    averaged over rings one ``step`` wide between ``low`` and ``high`` (1/m), leaving
+    out the axis lines. With ``sector=(angle, width)`` only wavevectors within
+    width/2 of the angle (mod π) count. Per ring: count, mean density (m⁴), mean and
+    variance of log |f|, and the window's smoothing terms ``window_a`` =
+    <(sx² fx² + sy² fy²)/|f|⁴>, ``window_b`` = <(sx² + sy²)/|f|²> (sx, sy the frequency
+    steps). Works a block of rows at a time."""
+    from scipy import fft
+
+    ny, nx = field.shape
+    dx, dy = spacing
+    transform = fft.rfft2(field, workers=-1)
+    scale = dx * dy / (nx * ny * power)
+    fx = np.arange(1, (nx + 1) // 2) / (nx * dx)
+    fy = np.fft.fftfreq(ny, dy)
+    sx2, sy2 = (1 / (nx * dx)) ** 2, (1 / (ny * dy)) ** 2
+    rings = int(high / step) + 2
+    sums = np.zeros((6, rings + 1))
+    # Without a sector, rows +fy and -fy have the same geometry: take them in pairs.
+    paired = sector is None
+    last = ny // 2 + 1 if paired else ny
+    for start in range(1, last, rows_per_block):
+        rows = np.arange(start, min(start + rows_per_block, last))
+        partners = (ny - rows) % ny
+        weight = np.where(paired & (partners != rows), 2.0, 1.0)[:, np.newaxis]
+        squared = fy[rows, np.newaxis] ** 2 + fx**2
+        radius = np.sqrt(squared)
+        keep = (radius >= low) & (radius <= high)
+        if sector is not None:
+            angle = np.arctan2(fy[rows, np.newaxis], fx)
+            keep &= np.abs((angle - sector[0] + np.pi / 2) % np.pi - np.pi / 2) <= sector[1] / 2
+        index = np.where(keep, np.floor(radius / step).astype(np.int64), rings).ravel()
+        power_here = _power(transform[rows, 1: (nx + 1) // 2])
+        if paired:
+            power_here += np.where(partners != rows, 1.0, 0.0)[:, np.newaxis] * _power(transform[partners, 1: (nx + 1) // 2])
+        log_radius = np.log(radius)
+        columns = [
+            weight,
+            power_here * scale,
+            weight * log_radius,
+            weight * log_radius**2,
+            weight * (sx2 * fx**2 + sy2 * fy[rows, np.newaxis] ** 2) / squared**2,
+            weight * (sx2 + sy2) / squared,
+        ]
+        for row, values in enumerate(columns):
+            sums[row] += np.bincount(index, np.broadcast_to(values, radius.shape).ravel(), minlength=rings + 1)
+    used = sums[0, :rings] > 0
+    counts = sums[0, :rings][used]
+    means = sums[1:, :rings][:, used] / counts
+    return {
+        "count": counts.astype(np.int64),
+        "density": means[0],
+        "log_radius": means[1],
+        "log_spread": np.maximum(means[2] - means[1] ** 2, 0.0),
+        "window_a": means[3],
+        "window_b": means[4],
+        "window_factor": window_variance_factor(ny, nx),
+    }
+
+
+def _power(block):
+    return block.real.astype(np.float64) ** 2 + block.imag.astype(np.float64) ** 2
+
+
+def window_variance_factor(ny, nx):
+    """How much the Hann window's correlation between neighbouring ordinates inflates
+    the variance of a ring average: (N Σw⁴ / (Σw²)²) for each axis."""
+    factor = 1.0
+    for n in (ny, nx):
+        w = periodic_hann(n)
+        factor *= n * np.sum(w**4) / np.sum(w**2) ** 2
+    return factor
+
+
+def binned_spectrum(surface, order=1, per_decade=10):
+    """The spectrum of a gap-free surface after removing its form (polynomial of
+    ``order``), log-binned for output: profiles the Hann periodogram G (m³), maps the
+    ring-averaged periodic-Hann P2 (m⁴). Returns ``{"frequency", "density", "count"}``
+    (lists; 1/m) and, for profiles, ``"parseval"`` (Σ G Δf over the windowed power)."""
+    if surface.is_profile:
+        from ..metrology import detrend
+
+        levelled = detrend(surface, order=order)
+        frequencies, density, parseval = periodogram(levelled.heights, surface.spacing[0])
+        centres, means, counts = log_bins(frequencies, density, per_decade)
+        return {"frequency": centres.tolist(), "density": means.tolist(), "count": counts.tolist(), "parseval": parseval}
+    ny, nx = surface.heights.shape
+    step = max(1 / (nx * surface.spacing[0]), 1 / (ny * surface.spacing[1]))
+    field, power = windowed_map(surface, order)
+    rings = ring_spectrum(field, power, surface.spacing, step, min(0.5 / d for d in surface.spacing), step)
+    frequencies = np.exp(rings["log_radius"])
+    groups = np.floor(np.log10(frequencies) * per_decade + 1e-9).astype(int)
+    result = {"frequency": [], "density": [], "count": []}
+    for group in np.unique(groups):
+        members = groups == group
+        weights = rings["count"][members]
+        result["frequency"].append(float(np.exp(np.average(rings["log_radius"][members], weights=weights))))
+        result["density"].append(float(np.average(rings["density"][members], weights=weights)))
+        result["count"].append(int(weights.sum()))
+    return result
+
+
+def to_surfacetopography(frequencies, density):
+    """SurfaceTopography's 1-D PSD: ``(q, C1D)`` with q = 2πf and C1D = G/2."""
+    return 2 * np.pi * np.asarray(frequencies), np.asarray(density) / 2
+
+
+def to_gwyddion(frequencies, density):
+    """Gwyddion's one-sided angular PSDF: ``(k, W1)`` with k = 2πf and W1 = G/(2π)."""
+    return 2 * np.pi * np.asarray(frequencies), np.asarray(density) / (2 * np.pi)
+
+
+def to_ganti_bhushan(frequencies, density):
+    """Ganti & Bhushan's two-sided angular PSD: ``(ω, P)`` with ω = 2πf, P = G/(4π)."""
+    return 2 * np.pi * np.asarray(frequencies), np.asarray(density) / (4 * np.pi)
+
+
+def from_surfacetopography(q, c1d):
+    return np.asarray(q) / (2 * np.pi), 2 * np.asarray(c1d)
+
+
+def from_gwyddion(k, w1):
+    return np.asarray(k) / (2 * np.pi), 2 * np.pi * np.asarray(w1)
+
+
+def from_ganti_bhushan(omega, p):
+    return np.asarray(omega) / (2 * np.pi), 4 * np.pi * np.asarray(p)

@@ -1,0 +1,79 @@
+"""Band-limited resampling to a new spacing (profiles along x, maps along both axes).
+
+The ratio of old to new spacing is taken as a fraction up/down (to within 1e-9, with
+denominators up to 1000) and applied with scipy's polyphase filter
+(``resample_poly``): upsample by ``up``, low-pass with a Kaiser-windowed FIR at the
+lower of the two Nyquist frequencies, keep every ``down``-th sample. Coarsening
+therefore removes what the new spacing cannot hold instead of folding it back
+(aliasing); the top ~20 % below the new Nyquist frequency are attenuated by the
+filter's transition band, so fit fractal parameters below that.
+
+Refining (a smaller spacing) interpolates band-limited: it adds no power above the
+old Nyquist frequency, so a refined fractal surface is smooth at the new small
+scales rather than continued with synthetic roughness (synthesise for that).
+
+Ends are padded by linear extrapolation of the data (``padtype='line'``). Invalid
+points must be filled first (``fill=True``: linear interpolation along profiles,
+biharmonic inpainting for maps); the points that fall where data were missing are
+set back to NaN in the result.
+"""
+
+import fractions
+
+import numpy as np
+
+from ..errors import InputError
+
+MAX_DENOMINATOR = 1000
+
+
+def resample(surface, spacing, fill=False):
+    """``surface`` at the new ``spacing`` (metres; one value, or (dx, dy) for maps)."""
+    from scipy.signal import resample_poly
+
+    targets = tuple(np.broadcast_to(np.asarray(spacing, dtype=float), (surface.heights.ndim,)))
+    if not all(t > 0 and np.isfinite(t) for t in targets):
+        raise InputError(f"the new spacing must be positive, not {spacing}")
+    invalid = np.isnan(surface.heights)
+    if invalid.any() and not fill:
+        raise InputError("the surface has invalid points; resampling needs them filled first (--fill)")
+    heights = filled(surface) if invalid.any() else surface.heights
+    new_spacing = []
+    for axis, (old, new) in enumerate(zip(surface.spacing, targets)):
+        ratio = fractions.Fraction(old / new).limit_denominator(MAX_DENOMINATOR)
+        if abs(float(ratio) - old / new) > 1e-9 * old / new:
+            raise InputError(f"cannot resample {old:g} m to {new:g} m exactly with a ratio of small integers")
+        array_axis = heights.ndim - 1 - axis
+        if heights.shape[array_axis] * ratio < 2:
+            raise InputError(f"a spacing of {new:g} m leaves fewer than two points along {'xy'[axis]}")
+        heights = resample_poly(heights, ratio.numerator, ratio.denominator, axis=array_axis, padtype="line")
+        new_spacing.append(old / float(ratio))
+    if invalid.any():
+        heights = np.where(_nearest_invalid(invalid, surface.spacing, new_spacing, heights.shape), np.nan, heights)
+    return surface.derive("resample", {"spacing": new_spacing, "filled": bool(invalid.any())},
+                          heights=heights, spacing=tuple(new_spacing))
+
+
+def filled(surface):
+    """The heights with invalid points filled: linear interpolation along a profile,
+    scikit-image's biharmonic inpainting in a map."""
+    heights = surface.heights
+    invalid = np.isnan(heights)
+    if invalid.all():
+        raise InputError("no valid points to fill from")
+    if heights.ndim == 1:
+        index = np.arange(heights.size)
+        return np.interp(index, index[~invalid], heights[~invalid])
+    from skimage.restoration import inpaint_biharmonic
+
+    return inpaint_biharmonic(np.where(invalid, 0.0, heights), invalid)
+
+
+def _nearest_invalid(invalid, old_spacing, new_spacing, shape):
+    """Which new samples lie nearest to an old invalid one."""
+    index = []
+    for axis in range(invalid.ndim):
+        spatial = invalid.ndim - 1 - axis
+        positions = np.arange(shape[axis]) * new_spacing[spatial] / old_spacing[spatial]
+        index.append(np.clip(np.rint(positions).astype(int), 0, invalid.shape[axis] - 1))
+    return invalid[np.ix_(*index)]
