@@ -38,6 +38,9 @@ demo: $(BIN)/.installed
 	@echo
 	@echo '$$ rough synth --length 80mm --dimension 1.275 --rq 0.2781mm --seed 1 | rough resample --spacing 0.1545mm | rough fit-fractal'
 	@$(BIN)/rough synth --length 80mm --dimension 1.275 --rq 0.2781mm --seed 1 | $(BIN)/rough resample --spacing 0.1545mm | $(BIN)/rough fit-fractal
+	@echo
+	@echo '$$ rough synth --size 512x512 --spacing 10um --anisotropy 2.2,1um,2.5,3um,30 --seed 1 | rough rose --step 30 --plot $(DEMO)/rose.png'
+	@$(BIN)/rough synth --size 512x512 --spacing 10um --anisotropy 2.2,1um,2.5,3um,30 --seed 1 | $(BIN)/rough rose --step 30 --plot $(DEMO)/rose.png
 
 test: $(BIN)/.installed
 	$(BIN)/python -m pytest -q

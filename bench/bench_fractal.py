@@ -9,7 +9,8 @@ Figures, each measured in the same run (median of --repeat):
   - SurfaceTopography's fourier_synthesis and power_spectrum_from_area at the same
     size, when it is installed (pip install SurfaceTopography);
   - peak memory of synth and fit-fractal (tracemalloc, which numpy reports to) as a
-    multiple of the map's float64 size.
+    multiple of the map's float64 size;
+  - rose on a 2048 × 2048 map as a ratio to one rfft2 of it.
 """
 
 import argparse
@@ -21,6 +22,7 @@ from timing import median_time
 
 import rough
 from rough.fractal.fit import fit_fractal
+from rough.fractal.rose import rose
 from rough.fractal.synth import synthesize_map
 
 
@@ -59,6 +61,12 @@ def main():
           f"{synth_time / irfft_all:4.2f}× irfft2 on all cores ({irfft_all:.3f} s)   goal ≤ 1.5×")
     print(f"fit-fractal  {fit_time:6.3f} s = {fit_time / rfft_single:4.2f}× rfft2 single-threaded ({rfft_single:.3f} s)   goal ≤ 3×")
     print(f"peak memory  synth {synth_memory:.2f}×, fit-fractal {fit_memory:.2f}× the map's float64 size   goal ≤ 4×")
+    half = n // 2
+    small = synthesize_map((half, half), (spacing, spacing), 2.3, amplitude=1e-6, seed=2, rolloff=half * spacing / 16)
+    small_field = np.random.default_rng(1).standard_normal((half, half))
+    rfft_small = median_time(lambda: fft.rfft2(small_field), repeat)
+    rose_time = median_time(lambda: rose(small), repeat)
+    print(f"rose {half}×{half} {rose_time:6.3f} s = {rose_time / rfft_small:4.1f}× rfft2 single-threaded ({rfft_small:.3f} s)")
     try:
         from SurfaceTopography.Generation import fourier_synthesis
     except ImportError:

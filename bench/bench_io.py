@@ -56,9 +56,9 @@ def formats(surface, folder, repeat):
     for fmt in ("x3p", "exr", "gsf", "npy", "tsv"):
         path = os.path.join(folder, f"map.{fmt}")
         times = 1 if fmt == "tsv" else repeat
-        written = median_time(lambda: surface.write(path), times)
+        written = median_time(lambda path=path: surface.write(path), times)
         spacing = {"spacing": surface.spacing} if fmt == "npy" else {}
-        loaded = median_time(lambda: read(path, **spacing), times)
+        loaded = median_time(lambda path=path, spacing=spacing: read(path, **spacing), times)
         print(
             f"{fmt:<10} write {written:7.3f} s ({written / write_raw:6.1f}× raw)   read {loaded:7.3f} s "
             f"({loaded / read_raw:6.1f}× raw)   file {os.path.getsize(path) / 1e6:7.1f} MB"

@@ -11,7 +11,7 @@ command line starts quickly.
 
 __version__ = "0.1.0"
 
-__all__ = ["Surface", "Units", "read", "__version__"]
+__all__ = ["Surface", "Units", "__version__", "read"]
 
 
 def __getattr__(name):

@@ -83,3 +83,33 @@ def spectrum_figure(frequencies, density, fit, title="power spectrum"):
     axes.legend(fontsize="small")
     figure.tight_layout()
     return figure
+
+
+def rose_figure(rose, title="direction dependence"):
+    """Polar roses of C(θ) and D(θ) with their standard errors, mirrored to 360°
+    (a spectrum is symmetric, P(-f) = P(f)), the principal direction and the lay
+    marked. θ is the wavevector direction, counter-clockwise from +x."""
+    plt = _pyplot()
+    figure, axes = plt.subplots(1, 2, subplot_kw={"projection": "polar"}, figsize=(10, 5))
+    theta = np.radians(np.concatenate([rose.angles, np.add(rose.angles, 180.0), [rose.angles[0] + 360.0]]))
+    panels = (
+        (axes[0], np.array(rose.amplitude_coefficient) * 1e9, np.array(rose.amplitude_coefficient_stderr) * 1e9,
+         f"C(θ) (nm) at η = {rose.resolution * 1e6:.4g} µm", "tab:red"),
+        (axes[1], np.array(rose.fractal_dimension), np.array(rose.fractal_dimension_stderr), "Ds(θ)", "tab:blue"),
+    )
+    for axis, values, errors, label, colour in panels:
+        closed = np.concatenate([values, values, values[:1]])
+        spread = np.concatenate([errors, errors, errors[:1]])
+        axis.plot(theta, closed, color=colour, lw=2)
+        axis.fill_between(theta, closed - spread, closed + spread, color=colour, alpha=0.2)
+        if axis is axes[1] and np.ptp(values) > 0:
+            axis.set_ylim(max(2.0, float(np.min(values)) - 0.05), min(3.0, float(np.max(values)) + 0.05))
+        inner, outer = axis.get_ylim()
+        for angle, style in ((rose.principal_direction, "-"), (rose.lay_direction, "--")):
+            for direction in (angle, angle + 180):
+                axis.plot(np.radians([direction, direction]), [inner, outer], style, color="0.3", lw=1)
+        axis.set_title(label, pad=14)
+    figure.suptitle(f"{title}\nprincipal wavevector {rose.principal_direction:.1f}° (solid), lay {rose.lay_direction:.1f}° (dashed); "
+                    f"Str {'undefined' if np.isnan(rose.Str) else format(rose.Str, '.3g')}, Std {rose.Std:.1f}°", fontsize=10)
+    figure.tight_layout()
+    return figure

@@ -13,9 +13,9 @@ import pathlib
 
 os.environ.setdefault("SOURCE_DATE_EPOCH", "1767225600")  # 2026-01-01
 
-import numpy as np  # noqa: E402
+import numpy as np
 
-from rough.fractal.synth import synthesize_map, synthesize_profile  # noqa: E402
+from rough.fractal.synth import synthesize_map, synthesize_profile
 
 HERE = pathlib.Path(__file__).resolve().parent
 

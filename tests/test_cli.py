@@ -157,7 +157,7 @@ def test_binary_output_to_a_terminal_is_refused(sample):
     try:
         result = subprocess.run(
             [sys.executable, "-m", "rough", "convert", str(sample["gsf"])],
-            stdout=terminal, stderr=subprocess.PIPE, timeout=60,
+            check=False, stdout=terminal, stderr=subprocess.PIPE, timeout=60,
         )
     finally:
         os.close(terminal)
@@ -170,7 +170,7 @@ def test_closed_downstream_pipe_ends_quietly(tmp_path):
     Surface(np.zeros(200000), (1e-6,)).write(tmp_path / "long.x3p")
     pipeline = subprocess.run(
         f"{sys.executable} -m rough convert -f tsv {tmp_path / 'long.x3p'} | head -n 3",
-        shell=True, capture_output=True, timeout=60,
+        check=False, shell=True, capture_output=True, timeout=60,
     )
     assert pipeline.stdout.decode().startswith("# rough")
     assert pipeline.stderr == b""

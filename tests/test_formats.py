@@ -1,4 +1,4 @@
-"""The other readers: text dialects, GSF, OpenEXR, NPY and SDF, on hand-made files
+"""The other readers: text dialects, GSF, OpenEXR, NPY, SDF and AL3D, on hand-made files
 and on the third-party files of ../shared/data."""
 
 import io
@@ -178,6 +178,60 @@ def test_ascii_sdf_with_bad_points():
     assert np.isnan(surface.heights[0, 1]) and surface.heights[1, 1] == pytest.approx(4e-6)
 
 
+def al3d_file(depth, pixel=(1e-6, 2e-6), invalid=3e15, tags=None, cut=0):
+    """An AL3D file as MeasureSuite writes one: tags, a 256-byte comment, float32 rows
+    padded to 8 bytes."""
+    rows, cols = depth.shape
+    header = {"Cols": cols, "Rows": rows, "PixelSizeXMeter": pixel[0], "PixelSizeYMeter": pixel[1],
+              "InvalidPixelValue": invalid, "NumberOfPlanes": 0, "CreatingApplication": "hand-made"}
+    header.update(tags or {})
+    offset = 17 + 52 * (len(header) + 3) + 256
+    header["DepthImageOffset"] = header.get("DepthImageOffset", offset)
+
+    def tag(key, value):
+        return str(key).encode().ljust(20, b"\0") + str(value).encode().ljust(30, b"\0") + b"\r\n"
+
+    blob = b"AliconaImaging\0\r\n" + tag("Version", 1) + tag("TagCount", len(header))
+    blob += b"".join(tag(k, v) for k, v in header.items()) + b"\0" * 254 + b"\r\n"
+    stride = (cols * 4 + 7) // 8 * 8
+    body = b"".join(row.astype("<f4").tobytes().ljust(stride, b"\xaa") for row in depth)
+    blob += body
+    return blob[: len(blob) - cut]
+
+
+def test_al3d_rows_padded_to_eight_bytes_and_invalid_points():
+    depth = np.arange(15, dtype=np.float32).reshape(3, 5) * np.float32(1e-6)
+    depth[1, 2] = 3e15
+    surface = read_bytes(al3d_file(depth))
+    expected = depth.astype(np.float64)
+    expected[1, 2] = np.nan
+    np.testing.assert_array_equal(surface.heights, expected)
+    assert surface.spacing == (1e-6, 2e-6)
+    assert surface.metadata["instrument"] == "hand-made"
+    assert surface.source_format == "al3d"
+
+
+@pytest.mark.parametrize("blob_options,message", [
+    ({"cut": 8}, "runs past the end"),
+    ({"tags": {"Cols": "abc"}}, "Cols is 'abc'"),
+    ({"tags": {"PixelSizeXMeter": "0"}}, "not a pixel size"),
+    ({"tags": {"DepthImageOffset": 0}}, "no depth image"),
+    ({"tags": {"DepthImageOffset": 10**9}}, "runs past the end"),
+])
+def test_al3d_refusals(blob_options, message):
+    with pytest.raises(FormatError, match=message):
+        read_bytes(al3d_file(np.ones((4, 6), np.float32), **blob_options))
+
+
+def test_al3d_broken_header_is_refused():
+    blob = bytearray(al3d_file(np.ones((4, 6), np.float32)))
+    blob[17 + 52 * 3 - 2] = ord("X")
+    with pytest.raises(FormatError, match="CRLF"):
+        read_bytes(bytes(blob))
+    with pytest.raises(FormatError, match="truncated"):
+        read_bytes(bytes(blob[:100]))
+
+
 def test_gzipped_input(tmp_path):
     import gzip
 
@@ -214,6 +268,22 @@ def test_hfm_line_scan_rms(shared_data):
     from rough.summary import summary
 
     assert summary(read(shared_data / "SurfaceTopography/hfm-1.hfm"))["Rq"] == pytest.approx(0.000905688e-3, rel=1e-6)
+
+
+def test_al3d_matches_surfacetopography(shared_data):
+    """INDEX.md's values: Sq about the mean, Rq with each x profile's own mean removed,
+    and Rq of the transpose (profiles along y), which tells the axes apart."""
+    surface = read(shared_data / "SurfaceTopography/al3d-1.al3d")
+    assert surface.points == (200, 296)
+    np.testing.assert_allclose(surface.size, (8.76054e-05, 1.29655992e-04), rtol=1e-6)
+    heights = surface.heights
+
+    def rq(rows):
+        return np.sqrt(np.mean((rows - rows.mean(axis=1, keepdims=True)) ** 2))
+
+    assert np.std(heights) == pytest.approx(7.688266102603082e-06, rel=1e-6)
+    assert rq(heights) == pytest.approx(3.915731160953795e-06, rel=1e-6)
+    assert rq(heights.T) == pytest.approx(6.620846789152015e-06, rel=1e-6)
 
 
 def test_xyz_grid_matches_surfacetopography_transposed(shared_data):

@@ -90,8 +90,9 @@ def test_synth_refusals(args, message):
 
 
 def test_fit_refusals(tmp_path):
-    from rough import Surface
     import numpy as np
+
+    from rough import Surface
 
     heights = np.sin(np.arange(500) / 7.0)
     heights[40] = np.nan

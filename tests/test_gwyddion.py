@@ -17,7 +17,7 @@ IDENTIFIED = {"x3p": "ISO 5436-2 OpenGPS data (.x3p)", "gsf": "Gwyddion Simple F
 
 
 def gwyddion(*args):
-    return subprocess.run(["gwyddion", *map(str, args)], capture_output=True, text=True, timeout=120)
+    return subprocess.run(["gwyddion", *map(str, args)], check=False, capture_output=True, text=True, timeout=120)
 
 
 def converted(path, tmp_path):
@@ -66,3 +66,14 @@ def test_gwyddion_reads_a_profile_from_gsf_as_one_row(tmp_path):
     field = converted(tmp_path / "profile.gsf", tmp_path)["/0/data"]
     np.testing.assert_allclose(field.data[0], profile.heights, rtol=1e-6)
     assert field.xreal == pytest.approx(300 * 2e-6, rel=1e-12)
+
+
+def test_gwyddion_reads_al3d_as_rough_does(shared_data, tmp_path):
+    """A real Alicona file, read by Gwyddion's own AL3D module and by rough."""
+    from rough import read
+
+    path = shared_data / "SurfaceTopography/al3d-1.al3d"
+    field = converted(path, tmp_path)["/0/data"]
+    surface = read(path)
+    np.testing.assert_array_equal(field.data, surface.heights)
+    assert (field["xreal"], field["yreal"]) == pytest.approx(surface.size, rel=1e-12)

@@ -10,8 +10,16 @@ from hypothesis import strategies as st
 from rough import Surface
 from rough.errors import InputError
 from rough.metrology import (
-    areal_parameters, detect_features, detrend, mean_line, parameters, polynomial_form, profile_parameters,
-    rq_versus_length, split, transmission,
+    areal_parameters,
+    detect_features,
+    detrend,
+    mean_line,
+    parameters,
+    polynomial_form,
+    profile_parameters,
+    rq_versus_length,
+    split,
+    transmission,
 )
 from rough.metrology.filters import ALPHA
 

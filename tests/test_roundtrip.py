@@ -56,10 +56,10 @@ def surfaces(draw):
     )
 
 
-def round_trip(surface, fmt, options=ReadOptions()):
+def round_trip(surface, fmt, options=None):
     buffer = io.BytesIO()
     surface.write(buffer, fmt)
-    return read_bytes(buffer.getvalue(), options)
+    return read_bytes(buffer.getvalue(), options or ReadOptions())
 
 
 @pytest.mark.parametrize("fmt", FLOAT64 + FLOAT32)

@@ -91,8 +91,8 @@ def _rows(result, surface, document):
         ("structure_function_coefficient", result.structure_function_coefficient, "m",
          f"{format_length(result.structure_function_coefficient)} (Ganti & Bhushan's C_S at η)"),
         ("band", list(result.band), "1/m",
-         f"{low * 1e-3:.4g} to {high * 1e-3:.4g} /mm (wavelengths {format_length(1 / high)} to {format_length(1 / low)}), "
-         f"{result.frequencies_used} frequencies"),
+         (f"{low * 1e-3:.4g} to {high * 1e-3:.4g} /mm (wavelengths {format_length(1 / high)} to {format_length(1 / low)}), "
+          f"{result.frequencies_used} frequencies")),
         ("method", result.method, "", f"{result.method}; window {result.window}; sampling {result.sampling}"),
     ]
     if "parseval" in document:

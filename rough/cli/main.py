@@ -24,6 +24,7 @@ COMMANDS = {
     "synth": "rough.cli.synth:synth",
     "fit-fractal": "rough.cli.fit_fractal:fit_fractal",
     "resample": "rough.cli.resample:resample",
+    "rose": "rough.cli.rose:rose",
 }
 
 log = logging.getLogger("rough")
@@ -128,7 +129,7 @@ def run(args):
         where = f"{error.filename}: " if error.filename else ""
         _report(error, debug, f"{where}{error.strerror or error}")
         return 1
-    except Exception as error:  # the last resort: say what failed, in one line
+    except Exception as error:  # noqa: BLE001 -- the last resort: say what failed, in one line
         _report(error, debug, f"internal error: {type(error).__name__}: {error} (run with --debug for details)")
         return 1
 

@@ -53,11 +53,13 @@ class AnisotropyType(click.ParamType):
 @click.option("--seed", type=click.IntRange(0, 2**63 - 1), help="Random seed; the same seed gives bit-identical output (recorded in the history either way).")
 @click.option("--anisotropy", type=AnisotropyType(),
               help="Map: Ds and C along the wavevector direction ANGLE (degrees from +x) and at right angles, e.g. 2.2,1um,2.4,3um,30.")
+@click.option("--rolloff", type=LENGTH, help="Wavelength beyond which the spectrum is flat: self-affine only below it (rock is, over finite scales).")
 @click.option("--fragments", type=click.IntRange(4, None), is_flag=False, flag_value=128,
               help="The paper's method, for comparison: fragments of this many points (default 128), each started where the last ended.")
 @click.option("--as-printed", is_flag=True, help="With --fragments: also apply the paper's printed (k+1) index shift.")
 @surface_output
-def synth(length, points, size, spacing, dimension, amplitude, resolution, rq, seed, anisotropy, fragments, as_printed, output):
+def synth(length, points, size, spacing, dimension, amplitude, resolution, rq, seed, anisotropy, rolloff, fragments, as_printed,
+          output):
     """Synthesise a fractal profile (--length or --points) or map (--size) whose
     power spectrum is G(f) = C η^(2D-3) f^-(5-2D), in one inverse transform over
     the whole length: independent Gaussian coefficients, no DC term, so the
@@ -81,13 +83,15 @@ def synth(length, points, size, spacing, dimension, amplitude, resolution, rq, s
     if size is not None:
         if fragments or length is not None or points is not None:
             raise InputError("a map takes --size only (no --length, --points or --fragments)")
-        surface = make.synthesize_map(size, (spacing, spacing), dimension, amplitude, rq, resolution, seed, anisotropy)
+        surface = make.synthesize_map(size, (spacing, spacing), dimension, amplitude, rq, resolution, seed, anisotropy, rolloff)
     else:
         if anisotropy is not None:
             raise InputError("--anisotropy needs a map (--size)")
         count = points if points is not None else round(length / spacing)
         if fragments:
+            if rolloff is not None:
+                raise InputError("--rolloff does not apply to the paper's fragments")
             surface = make.synthesize_fragments(count, spacing, dimension, amplitude, rq, resolution, seed, fragments, as_printed)
         else:
-            surface = make.synthesize_profile(count, spacing, dimension, amplitude, rq, resolution, seed)
+            surface = make.synthesize_profile(count, spacing, dimension, amplitude, rq, resolution, seed, rolloff)
     output.write(surface)

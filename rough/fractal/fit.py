@@ -138,6 +138,8 @@ def _whittle_profile(heights, spacing, band, resolution, sampling):
         return len(u) * math.log(np.mean(ordinates * np.exp(-log_shape))) + log_shape.sum()
 
     beta = _minimise(profile_likelihood)
+    if at_fractal_edge(beta):
+        warn_at_edge()
     scale = np.mean(ordinates * np.exp(-shape(beta)))  # = 2A
     derivative = (shape(beta + 1e-5) - shape(beta - 1e-5)) / 2e-5
     covariance = np.linalg.inv(np.array([[len(u), derivative.sum()], [derivative.sum(), (derivative**2).sum()]]))
@@ -166,10 +168,17 @@ def _minimise(function):
     from scipy.optimize import minimize_scalar
 
     result = minimize_scalar(function, bounds=BETA_RANGE, method="bounded", options={"xatol": 1e-7})
-    if min(abs(result.x - b) for b in BETA_RANGE) < 1e-3:
-        log.warning("the fitted exponent is at the edge of the fractal range (D at 1 or 2): the data do not follow a "
-                    "fractal power law in this band")
     return float(result.x)
+
+
+def at_fractal_edge(beta):
+    """Whether a fitted profile exponent β (or map α - 1) sits at the end of (1, 3)."""
+    return min(abs(beta - b) for b in BETA_RANGE) < 1e-3
+
+
+def warn_at_edge(where="", dimension="D at 1 or 2"):
+    log.warning(f"the fitted exponent is at the edge of the fractal range ({dimension}){where}: the data do not "
+                "follow a fractal power law in this band (see --band)")
 
 
 def _result(beta, covariance, prefactor, resolution, band, method, window, sampling, count):
@@ -224,17 +233,17 @@ def _whittle_map(surface, order, band, resolution, sampling, sector):
     del field
     if rings["count"].size < 4:
         raise InputError(f"only {rings['count'].size} frequency rings in the fit band; widen --band")
-    alpha, prefactor, covariance = _fit_rings(rings)
-    surface_dimension = (8.0 - alpha) / 2.0
-    amplitude = model.map_amplitude(prefactor, surface_dimension, resolution)
-    gradient = np.array([1.0, math.log(resolution) - _map_factor_slope(surface_dimension)])
+    fit = ring_fit(rings, resolution)
+    if fit["at_edge"]:
+        warn_at_edge(dimension="Ds at 2 or 3")
+    surface_dimension, amplitude = fit["dimension"], fit["amplitude"]
     return FractalFit(
         fractal_dimension=surface_dimension,
-        fractal_dimension_stderr=math.sqrt(covariance[1, 1]) / 2,
+        fractal_dimension_stderr=fit["dimension_error"],
         amplitude_coefficient=amplitude,
-        amplitude_coefficient_stderr=amplitude * math.sqrt(max(gradient @ covariance @ gradient, 0.0)),
+        amplitude_coefficient_stderr=fit["amplitude_error"],
         resolution=resolution,
-        psd_prefactor=float(prefactor),
+        psd_prefactor=fit["prefactor"],
         hurst=3.0 - surface_dimension,
         band=(float(low), float(high)),
         method="whittle (ring-binned 2-D periodogram)" + ("" if sector is None else ", sector"),
@@ -244,6 +253,24 @@ def _whittle_map(surface, order, band, resolution, sampling, sector):
         structure_function_coefficient=amplitude / model.structure_factor(surface_dimension - 1.0),
         profile_dimension=surface_dimension - 1.0,
     )
+
+
+def ring_fit(rings, resolution):
+    """Ds and C (at η = ``resolution``) with standard errors from ring means, and
+    whether the exponent sits at the edge of the fractal range."""
+    alpha, prefactor, covariance = _fit_rings(rings)
+    dimension = (8.0 - alpha) / 2.0
+    amplitude = model.map_amplitude(prefactor, dimension, resolution)
+    gradient = np.array([1.0, math.log(resolution) - _map_factor_slope(dimension)])
+    return {
+        "dimension": dimension,
+        "dimension_error": math.sqrt(max(covariance[1, 1], 0.0)) / 2,
+        "amplitude": amplitude,
+        "amplitude_error": amplitude * math.sqrt(max(gradient @ covariance @ gradient, 0.0)),
+        "prefactor": float(prefactor),
+        "frequencies_used": int(rings["count"].sum()),
+        "at_edge": at_fractal_edge(alpha - 1.0),
+    }
 
 
 def _fit_rings(rings):

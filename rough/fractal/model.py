@@ -14,7 +14,6 @@ C. ``C2`` is the map's ``psd_prefactor``.
 
 import math
 
-
 from ..errors import InputError
 
 

@@ -14,6 +14,8 @@ Other conventions of the same spectrum (all functions of frequency f in 1/m):
 """
 
 
+import math
+
 import numpy as np
 
 from ..errors import InputError
@@ -89,24 +91,37 @@ def windowed_map(surface, order=1, rows_per_block=256):
 def ring_spectrum(field, power, spacing, low, high, step, sector=None, rows_per_block=256):
     """The two-sided 2-D periodogram of a windowed map (see :func:`windowed_map`),
     averaged over rings one ``step`` wide between ``low`` and ``high`` (1/m), leaving
-    out the axis lines. With ``sector=(angle, width)`` only wavevectors within
-    width/2 of the angle (mod π) count. Per ring: count, mean density (m⁴), mean and
-    variance of log |f|, and the window's smoothing terms ``window_a`` =
+    out the axis lines. With ``sector=(angle, width)`` (radians) only wavevectors
+    within width/2 of the angle (mod π) count. Per ring: count, mean density (m⁴),
+    mean and variance of log |f|, and the window's smoothing terms ``window_a`` =
     <(sx² fx² + sy² fy²)/|f|⁴>, ``window_b`` = <(sx² + sy²)/|f|²> (sx, sy the frequency
-    steps). Works a block of rows at a time."""
+    steps)."""
+    sectors = None if sector is None else (sector[0], math.pi, 1, sector[1])
+    return sector_spectra(field, power, spacing, low, high, step, sectors, rows_per_block)[0]
+
+
+def sector_spectra(field, power, spacing, low, high, step, sectors=None, rows_per_block=256, transform=None):
+    """Ring spectra (as :func:`ring_spectrum`) for several direction sectors from one
+    FFT: ``sectors = (first angle, angular step, count, width)`` in radians gives
+    sectors centred at first + k·step (mod π), each taking the wavevectors within
+    width/2 of its centre (sectors overlap when the width exceeds the step). Returns
+    one ring dictionary per sector (one in all without sectors). Works a block of rows
+    at a time; pass ``transform`` (the field's rfft2) to reuse one."""
     from scipy import fft
 
     ny, nx = field.shape
     dx, dy = spacing
-    transform = fft.rfft2(field, workers=-1)
+    transform = fft.rfft2(field, workers=-1) if transform is None else transform
     scale = dx * dy / (nx * ny * power)
     fx = np.arange(1, (nx + 1) // 2) / (nx * dx)
     fy = np.fft.fftfreq(ny, dy)
     sx2, sy2 = (1 / (nx * dx)) ** 2, (1 / (ny * dy)) ** 2
     rings = int(high / step) + 2
-    sums = np.zeros((6, rings + 1))
-    # Without a sector, rows +fy and -fy have the same geometry: take them in pairs.
-    paired = sector is None
+    groups = 1 if sectors is None else sectors[2]
+    stride = rings + 1
+    sums = np.zeros((6, groups * stride + 1))
+    # Without sectors, rows +fy and -fy have the same geometry: take them in pairs.
+    paired = sectors is None
     last = ny // 2 + 1 if paired else ny
     for start in range(1, last, rows_per_block):
         rows = np.arange(start, min(start + rows_per_block, last))
@@ -115,36 +130,59 @@ def ring_spectrum(field, power, spacing, low, high, step, sector=None, rows_per_
         squared = fy[rows, np.newaxis] ** 2 + fx**2
         radius = np.sqrt(squared)
         keep = (radius >= low) & (radius <= high)
-        if sector is not None:
-            angle = np.arctan2(fy[rows, np.newaxis], fx)
-            keep &= np.abs((angle - sector[0] + np.pi / 2) % np.pi - np.pi / 2) <= sector[1] / 2
-        index = np.where(keep, np.floor(radius / step).astype(np.int64), rings).ravel()
+        ring = np.floor(radius / step).astype(np.int64)
         power_here = _power(transform[rows, 1: (nx + 1) // 2])
         if paired:
             power_here += np.where(partners != rows, 1.0, 0.0)[:, np.newaxis] * _power(transform[partners, 1: (nx + 1) // 2])
         log_radius = np.log(radius)
         columns = [
-            weight,
-            power_here * scale,
-            weight * log_radius,
-            weight * log_radius**2,
-            weight * (sx2 * fx**2 + sy2 * fy[rows, np.newaxis] ** 2) / squared**2,
-            weight * (sx2 + sy2) / squared,
+            np.broadcast_to(weight, radius.shape).ravel(),
+            (power_here * scale).ravel(),
+            (weight * log_radius).ravel(),
+            (weight * log_radius**2).ravel(),
+            (weight * (sx2 * fx**2 + sy2 * fy[rows, np.newaxis] ** 2) / squared**2).ravel(),
+            np.broadcast_to(weight * (sx2 + sy2) / squared, radius.shape).ravel(),
         ]
-        for row, values in enumerate(columns):
-            sums[row] += np.bincount(index, np.broadcast_to(values, radius.shape).ravel(), minlength=rings + 1)
-    used = sums[0, :rings] > 0
-    counts = sums[0, :rings][used]
-    means = sums[1:, :rings][:, used] / counts
-    return {
-        "count": counts.astype(np.int64),
-        "density": means[0],
-        "log_radius": means[1],
-        "log_spread": np.maximum(means[2] - means[1] ** 2, 0.0),
-        "window_a": means[3],
-        "window_b": means[4],
-        "window_factor": window_variance_factor(ny, nx),
-    }
+        for group, member in _memberships(np.arctan2(fy[rows, np.newaxis], fx), sectors):
+            index = np.where(keep & member, group * stride + ring, groups * stride).ravel()
+            for row, values in enumerate(columns):
+                sums[row] += np.bincount(index, values, minlength=groups * stride + 1)
+    results = []
+    for group in range(groups):
+        part = sums[:, group * stride: group * stride + rings]
+        used = part[0] > 0
+        counts = part[0][used]
+        means = part[1:, used] / counts
+        results.append({
+            "count": counts.astype(np.int64),
+            "density": means[0],
+            "log_radius": means[1],
+            "log_spread": np.maximum(means[2] - means[1] ** 2, 0.0),
+            "window_a": means[3],
+            "window_b": means[4],
+            "window_factor": window_variance_factor(ny, nx),
+        })
+    return results
+
+
+def _memberships(angle, sectors):
+    """``(sector index array, membership mask)`` pairs, one per pass, covering each
+    wavevector's sectors: a wavevector at angle φ lies in sector k when φ is within
+    width/2 of first + k·step, modulo π."""
+    if sectors is None:
+        yield 0, True
+        return
+    first, step, count, width = sectors
+    if abs(width - step) < 1e-12 and abs(count * step - np.pi) < 1e-9:
+        yield np.rint((angle - first) / step).astype(np.int64) % count, True  # sectors tile the half plane
+        return
+    offset = (angle - first + width / 2) % np.pi
+    top = np.floor(offset / step).astype(np.int64)
+    for back in range(int(width // step) + 1):
+        index = top - back
+        centre = first + index * step
+        member = (index >= 0) & (np.abs((angle - centre + np.pi / 2) % np.pi - np.pi / 2) <= width / 2 + 1e-12)
+        yield np.where(member, index % count, 0), member
 
 
 def _power(block):

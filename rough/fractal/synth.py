@@ -36,29 +36,34 @@ PAPER_FRAGMENT = 128
 PAPER_RESOLUTION = 0.0309e-3
 
 
-def synthesize_profile(points, spacing, dimension, amplitude=None, rq=None, resolution=None, seed=None):
+def synthesize_profile(points, spacing, dimension, amplitude=None, rq=None, resolution=None, seed=None, rolloff=None):
     """A fractal profile of ``points`` samples at ``spacing`` (metres) with fractal
     dimension D (1-2) and either the amplitude coefficient ``amplitude`` (metres, at
-    ``resolution``, default the spacing) or the RMS height ``rq`` (metres)."""
+    ``resolution``, default the spacing) or the RMS height ``rq`` (metres). With a
+    ``rolloff`` wavelength (metres) the spectrum is flat at longer wavelengths: the
+    surface is self-affine only below that scale."""
     beta = model.profile_exponent(dimension)
     resolution = _amplitude_choice(amplitude, rq, resolution, spacing)
     seed = _seed(seed)
     generator = np.random.Generator(np.random.PCG64(np.random.SeedSequence(seed)))
     spectrum = _white_profile_spectrum(points, generator)
-    spectrum *= _profile_filter(points, spacing, beta, model.prefactor(amplitude or 1.0, dimension, resolution))
+    spectrum *= _profile_filter(points, spacing, beta, model.prefactor(amplitude or 1.0, dimension, resolution),
+                                rolloff=rolloff)
     heights = _scaled(np.fft.irfft(spectrum, points), rq)
     parameters = _parameters(points=points, spacing=spacing, dimension=dimension, amplitude=amplitude, rq=rq,
-                             resolution=resolution, seed=seed)
+                             resolution=resolution, seed=seed, rolloff=rolloff)
     return _surface(heights, (spacing,), parameters)
 
 
-def synthesize_map(points, spacing, dimension, amplitude=None, rq=None, resolution=None, seed=None, anisotropy=None):
+def synthesize_map(points, spacing, dimension, amplitude=None, rq=None, resolution=None, seed=None, anisotropy=None,
+                   rolloff=None):
     """A fractal map of ``points = (nx, ny)`` at ``spacing = (dx, dy)`` with surface
     dimension Ds (2-3) and the profile-equivalent amplitude coefficient ``amplitude``
     (or the RMS height ``rq``). ``anisotropy = (Ds1, C1, Ds2, C2, angle)`` gives Ds and
     C along the wavevector direction ``angle`` (radians from +x, counter-clockwise)
     and along the direction at right angles; in between, Ds and log C follow
-    cos²/sin² of the angle, so the spectrum is P2 = C2(θ) |f|^-(8-2Ds(θ))."""
+    cos²/sin² of the angle, so the spectrum is P2 = C2(θ) |f|^-(8-2Ds(θ)). A
+    ``rolloff`` wavelength makes the spectrum flat at longer wavelengths."""
     nx, ny = points
     dx, dy = spacing
     if anisotropy is not None:
@@ -72,13 +77,16 @@ def synthesize_map(points, spacing, dimension, amplitude=None, rq=None, resoluti
     seed = _seed(seed)
     spectrum = _white_map_spectrum(nx, ny, seed)
     pairs = spectrum.view(np.float32).reshape(ny, nx // 2 + 1, 2)
-    pairs *= _map_filter(nx, ny, dx, dy, dimension, amplitude or 1.0, resolution, anisotropy)[..., np.newaxis]
+    pairs *= _map_filter(nx, ny, dx, dy, dimension, amplitude or 1.0, resolution, anisotropy, rolloff)[..., np.newaxis]
     from scipy import fft
 
     heights = _scaled(fft.irfft2(spectrum, (ny, nx), workers=-1, overwrite_x=True).astype(np.float64), rq)
-    parameters = _parameters(points=[nx, ny], spacing=[dx, dy], dimension=dimension, amplitude=amplitude, rq=rq,
-                             resolution=resolution, seed=seed,
-                             anisotropy=None if anisotropy is None else [*anisotropy[:4], math.degrees(anisotropy[4])])
+    if anisotropy is None:
+        shape = {"dimension": dimension, "amplitude": amplitude}
+    else:
+        shape = {"anisotropy": [*anisotropy[:4], math.degrees(anisotropy[4])]}
+    parameters = _parameters(points=[nx, ny], spacing=[dx, dy], **shape, rq=rq, resolution=resolution, seed=seed,
+                             rolloff=rolloff)
     return _surface(heights, (dx, dy), parameters)
 
 
@@ -158,22 +166,27 @@ def _white_map_spectrum(nx, ny, seed):
     return spectrum
 
 
-def _profile_filter(n, spacing, beta, scale, shift=0):
-    """sqrt(G(f_k) / (2Δx)) with G = scale · f^-β; zero at k = 0 unless shifted."""
+def _profile_filter(n, spacing, beta, scale, shift=0, rolloff=None):
+    """sqrt(G(f_k) / (2Δx)) with G = scale · f^-β (flat below 1/rolloff); zero at
+    k = 0 unless shifted."""
     index = np.arange(n // 2 + 1, dtype=np.float64) + shift
     frequencies = index / (n * spacing)
+    if rolloff is not None:
+        frequencies = np.where(index > 0, np.maximum(frequencies, 1 / rolloff), 0.0)
     with np.errstate(divide="ignore"):
         gain = np.sqrt(scale * frequencies**-beta / (2 * spacing))
     gain[~np.isfinite(gain)] = 0.0
     return gain
 
 
-def _map_filter(nx, ny, dx, dy, dimension, amplitude, resolution, anisotropy):
-    """sqrt(P2(f) / (Δx Δy)) on the rfft2 grid, in float32 (the coefficients it
-    shapes are float64), zero at f = 0."""
+def _map_filter(nx, ny, dx, dy, dimension, amplitude, resolution, anisotropy, rolloff=None):
+    """sqrt(P2(f) / (Δx Δy)) on the rfft2 grid, in float32, zero at f = 0 (and flat
+    below 1/rolloff)."""
     fx = (np.arange(nx // 2 + 1) / (nx * dx)).astype(np.float32)
     fy = np.fft.fftfreq(ny, dy).astype(np.float32)
     squared = fy[:, np.newaxis] ** 2 + fx[np.newaxis, :] ** 2
+    if rolloff is not None:
+        np.maximum(squared, np.float32(rolloff**-2), out=squared)
     squared[0, 0] = 1.0
     if anisotropy is None:
         alpha = model.map_exponent(dimension)
@@ -216,5 +229,13 @@ def _surface(heights, spacing, parameters):
 
 
 def _title(parameters, ndim):
-    amount = f"{'Rq' if ndim == 1 else 'Sq'} {parameters['rq']:.4g} m" if "rq" in parameters else f"C {parameters['amplitude']:.4g} m"
-    return f"synthetic fractal, {'D' if ndim == 1 else 'Ds'} = {parameters['dimension']:g}, {amount}, seed {parameters['seed']}"
+    from ..units import format_length
+
+    seed = parameters["seed"]
+    if "anisotropy" in parameters:
+        ds1, c1, ds2, c2, angle = parameters["anisotropy"]
+        return (f"synthetic anisotropic fractal, Ds = {ds1:g} and C = {format_length(c1)} along {angle:g}°, "
+                f"Ds = {ds2:g} and C = {format_length(c2)} along {(angle + 90) % 180:g}°, seed {seed}")
+    amount = (f"{'Rq' if ndim == 1 else 'Sq'} {format_length(parameters['rq'])}" if "rq" in parameters
+              else f"C {format_length(parameters['amplitude'])}")
+    return f"synthetic fractal, {'D' if ndim == 1 else 'Ds'} = {parameters['dimension']:g}, {amount}, seed {seed}"

@@ -9,7 +9,7 @@ output format follows ``format=`` or the file extension, and a stream gets X3P.
 
 Formats (one module each): X3P (ISO 25178-72), OpenEXR, GSF (Gwyddion Simple Field),
 text (TSV/CSV columns, Dektak CSV, Gwyddion text export, x y z grids), NPY, and
-ISO 25178-71 SDF (read only). Gzip-compressed input is unpacked first.
+ISO 25178-71 SDF and Alicona AL3D (read only). Gzip-compressed input is unpacked first.
 """
 
 import dataclasses
@@ -34,11 +34,12 @@ FORMATS = {
     "tsv": "text",
     "npy": "NumPy NPY",
     "sdf": "ISO 25178-71 SDF",
+    "al3d": "Alicona AL3D",
 }
 WRITABLE = ("x3p", "exr", "gsf", "tsv", "npy")
 BINARY = ("x3p", "exr", "gsf", "npy")
 EXTENSIONS = {".x3p": "x3p", ".exr": "exr", ".gsf": "gsf", ".tsv": "tsv", ".txt": "tsv", ".npy": "npy"}
-_MODULES = {"x3p": "x3p", "exr": "exr", "gsf": "gsf", "tsv": "text", "npy": "npy", "sdf": "sdf"}
+_MODULES = {"x3p": "x3p", "exr": "exr", "gsf": "gsf", "tsv": "text", "npy": "npy", "sdf": "sdf", "al3d": "al3d"}
 _MAGIC = (
     (b"PK\x03\x04", "x3p"),
     (b"PK\x05\x06", "x3p"),
@@ -47,6 +48,7 @@ _MAGIC = (
     (b"\x93NUMPY", "npy"),
     (b"aISO-1.0", "sdf"),
     (b"bISO-1.0", "sdf"),
+    (b"AliconaImaging\0", "al3d"),
 )
 GZIP_MAGIC = b"\x1f\x8b"
 log = logging.getLogger("rough")

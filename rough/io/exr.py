@@ -19,10 +19,10 @@ import io
 
 import numpy as np
 
-from . import provenance
 from ..errors import FormatError
 from ..surface import Surface, Units
 from ..units import metres_per
+from . import provenance
 
 HEIGHT_CHANNELS = ("Y", "Z", "R")
 MAX_POINTS = 1 << 31
@@ -93,7 +93,7 @@ def write(surface, stream):
 def _open(OpenEXR, data, header_only=False):
     try:
         return OpenEXR.File(io.BytesIO(bytes(data)), separate_channels=True, header_only=header_only)
-    except Exception as error:  # the bindings raise plain RuntimeError/Exception for bad files
+    except Exception as error:  # noqa: BLE001 -- the bindings raise plain RuntimeError/Exception for bad files
         raise FormatError(f"not a readable OpenEXR file ({error})") from None
 
 

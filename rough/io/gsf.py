@@ -13,10 +13,10 @@ metadata.
 
 import numpy as np
 
-from . import provenance
 from ..errors import FormatError
 from ..surface import Surface, Units
 from ..units import metres_per
+from . import provenance
 
 MAGIC = b"Gwyddion Simple Field 1.0"
 MAX_HEADER_BYTES = 1 << 20

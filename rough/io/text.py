@@ -27,11 +27,11 @@ import re
 
 import numpy as np
 
-from . import provenance
 from .. import __version__
 from ..errors import FormatError, InputError
 from ..surface import Surface, Units
 from ..units import metres_per
+from . import provenance
 
 _UNIT_IN_NAME = re.compile(r"[\[(]\s*([^\])]+?)\s*[\])]|\s([A-Za-zµμÅ]+)\s*$")
 _NUMERIC = re.compile(r"^[\s,;]*[+-]?(\d|\.\d|nan|inf|bad)", re.IGNORECASE)

@@ -34,10 +34,10 @@ from xml.sax.saxutils import escape as _escape
 
 import numpy as np
 
-from . import provenance
 from .. import __version__
 from ..errors import FormatError
 from ..surface import Surface, Units, timestamp
+from . import provenance
 
 NAMESPACE = "http://www.opengps.eu/2008/ISO5436_2"
 VENDOR_ID = "urn:x-rough:x3p-vendor:1"
@@ -435,7 +435,7 @@ def _main_xml(surface, data_md5, mask_md5):
         "<Record4><ChecksumFile>md5checksum.hex</ChecksumFile></Record4>\n"
         f"<VendorSpecificID>{VENDOR_ID}</VendorSpecificID>\n"
         "</p:ISO5436_2>\n"
-    ).encode("utf-8")
+    ).encode()
 
 
 _NOT_XML = re.compile("[^\t\n\r\u0020-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")

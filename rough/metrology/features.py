@@ -74,7 +74,7 @@ def _runs_above(signed, threshold, extension):
     edges = np.flatnonzero(np.diff(np.concatenate(([0], above.astype(np.int8), [0]))))
     spans = []
     for start, stop in zip(edges[::2], edges[1::2]):
-        grow = int(round(extension * (stop - start) / 2))
+        grow = round(extension * (stop - start) / 2)
         start, stop = max(0, start - grow), min(signed.size, stop + grow)
         if spans and start <= spans[-1][1]:
             spans[-1] = (spans[-1][0], max(stop, spans[-1][1]))
