@@ -41,6 +41,9 @@ demo: $(BIN)/.installed
 	@echo
 	@echo '$$ rough synth --size 512x512 --spacing 10um --anisotropy 2.2,1um,2.5,3um,30 --seed 1 | rough rose --step 30 --plot $(DEMO)/rose.png'
 	@$(BIN)/rough synth --size 512x512 --spacing 10um --anisotropy 2.2,1um,2.5,3um,30 --seed 1 | $(BIN)/rough rose --step 30 --plot $(DEMO)/rose.png
+	@echo
+	@echo '$$ rough render --speed 20mm/s --speed 120mm/s --plot $(DEMO)/forces.png sample_profiles/rock-profile.tsv   (the simulated hand)'
+	@$(BIN)/rough render --speed 20mm/s --speed 120mm/s --plot $(DEMO)/forces.png sample_profiles/rock-profile.tsv
 
 test: $(BIN)/.installed
 	$(BIN)/python -m pytest -q
@@ -49,6 +52,7 @@ bench: $(BIN)/.installed
 	$(BIN)/python bench/bench_io.py
 	$(BIN)/python bench/bench_metrology.py
 	$(BIN)/python bench/bench_fractal.py
+	$(BIN)/python bench/bench_render.py
 
 clean:
 	rm -rf build $(VENV) *.egg-info .pytest_cache .hypothesis

@@ -113,3 +113,39 @@ def rose_figure(rose, title="direction dependence"):
                     f"Str {'undefined' if np.isnan(rose.Str) else format(rose.Str, '.3g')}, Std {rose.Std:.1f}°", fontsize=10)
     figure.tight_layout()
     return figure
+
+
+def force_figure(runs):
+    """Force profiles of render runs ``[(label, Run), ...]``: for each, the surface
+    height under the stylus and the hand's height (top), and F_y and F_x against the
+    position along the profile (bottom), with the ticks out of contact shaded."""
+    plt = _pyplot()
+    figure, axes = plt.subplots(2, len(runs), figsize=(5.5 * len(runs), 6), sharex="col", squeeze=False,
+                                gridspec_kw={"height_ratios": [1, 1.4]})
+    for column, (label, result) in enumerate(runs):
+        trace = result.trace
+        x = trace["x"] * MM
+        top, bottom = axes[0, column], axes[1, column]
+        top.plot(x, trace["h"] * MM, color="0.3", lw=0.8, label="surface h")
+        top.plot(x, trace["y_i"] * MM, color="tab:green", lw=0.8, label="hand y_i")
+        bottom.plot(x, trace["F_y"], color="tab:blue", lw=0.7, label="F_y")
+        bottom.plot(x, trace["F_x"], color="tab:orange", lw=0.7, label="F_x")
+        for axis in (top, bottom):
+            _shade(axis, x, ~trace["contact"])
+        title = label if result.speed is None else f"{result.speed * 1e3:g} mm/s"
+        top.set_title(f"{title}: F_y std {trace['F_y'].std():.3f} N, out of contact {100 * (1 - trace['contact'].mean()):.1f} %",
+                      fontsize=9)
+        top.set_ylabel("height (mm)")
+        bottom.set_ylabel("force on the hand (N)")
+        bottom.set_xlabel("x (mm)")
+        top.legend(fontsize=7, loc="upper right")
+        bottom.legend(fontsize=7, loc="upper right")
+    figure.tight_layout()
+    return figure
+
+
+def _shade(axis, x, mask):
+    """Grey spans where ``mask`` holds (ticks out of contact)."""
+    edges = np.flatnonzero(np.diff(np.concatenate(([0], mask.astype(np.int8), [0]))))
+    for start, stop in zip(edges[::2], edges[1::2]):
+        axis.axvspan(x[start], x[min(stop, x.size - 1)], color="0.85", lw=0)

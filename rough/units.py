@@ -113,3 +113,42 @@ def parse_frequency(text, default_unit="mm"):
     if not math.isfinite(value) or value < 0:
         raise InputError(f"{text!r} is not a usable spatial frequency")
     return value
+
+
+# Physical quantities for the haptic renderer: SI factor of each unit a person may type.
+# The sources write stiffness in N/mm, damping in N·s/mm and speeds in mm/s.
+QUANTITIES = {
+    "force": ("N", {"N": 1.0, "mN": 1e-3, "kN": 1e3}),
+    "stiffness": ("N/m", {"N/m": 1.0, "N/mm": 1e3, "N/um": 1e6, "kN/m": 1e3}),
+    "damping": ("N*s/m", {"N*s/m": 1.0, "N*s/mm": 1e3, "kg/s": 1.0}),
+    "mass": ("kg", {"kg": 1.0, "g": 1e-3, "mg": 1e-6, "N*s^2/m": 1.0, "N*s^2/mm": 1e3}),
+    "speed": ("m/s", {"m/s": 1.0, "mm/s": 1e-3, "um/s": 1e-6, "cm/s": 1e-2}),
+    "time": ("s", {"s": 1.0, "ms": 1e-3, "us": 1e-6, "min": 60.0}),
+    "rate": ("Hz", {"Hz": 1.0, "kHz": 1e3}),
+}
+
+
+def parse_quantity(text, kind, default_unit=None):
+    """``parse_quantity('1.28N/mm', 'stiffness')`` → 1280.0 (SI). Units may be written
+    with ``*``, ``·`` or a space for products (``N*s/m``, ``N·s/mm``) and ``µ``/``u``
+    for micro; a bare number is in ``default_unit`` (refused if None)."""
+    units = QUANTITIES[kind][1]
+    match = _NUMBER_AND_UNIT.match(str(text).replace(" ", "").replace("·", "*"))
+    unit = None if not match else (match.group(2) or default_unit)
+    if unit is not None:
+        unit = unit.replace("µ", "u").replace("μ", "u").replace("Ns", "N*s").replace("**", "^").replace("²", "^2")
+    if unit not in units:
+        accepted = ", ".join(units)
+        raise InputError(f"{text!r} is not a {kind} (write a number with one of the units {accepted})")
+    value = float(match.group(1)) * units[unit]
+    if not math.isfinite(value):
+        raise InputError(f"{text!r} is not a finite {kind}")
+    return value
+
+
+def format_unit(value, kind, digits=4):
+    """``value`` (SI) printed in the unit the sources use for ``kind``:
+    N, N/mm, N·s/m, g, mm/s, s, Hz."""
+    shown = {"stiffness": (1e-3, "N/mm"), "mass": (1e3, "g"), "speed": (1e3, "mm/s"),
+             "damping": (1.0, "N·s/m")}.get(kind, (1.0, QUANTITIES[kind][0]))
+    return f"{value * shown[0]:.{digits}g} {shown[1]}"

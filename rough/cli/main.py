@@ -25,6 +25,7 @@ COMMANDS = {
     "fit-fractal": "rough.cli.fit_fractal:fit_fractal",
     "resample": "rough.cli.resample:resample",
     "rose": "rough.cli.rose:rose",
+    "render": "rough.cli.render:render",
 }
 
 log = logging.getLogger("rough")

@@ -47,6 +47,29 @@ class SpacingType(LengthType):
         return tuple(parts)
 
 
+class QuantityType(click.ParamType):
+    """A physical quantity with a unit (``1.28N/mm``, ``20mm/s``, ``1.85g``) → SI; a
+    bare number is in ``default_unit``."""
+
+    def __init__(self, kind, default_unit):
+        self.kind, self.default_unit = kind, default_unit
+        self.name = kind.upper()
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, float):
+            return value
+        from ..errors import InputError
+        from ..units import parse_quantity
+
+        try:
+            quantity = parse_quantity(value, self.kind, self.default_unit)
+        except InputError as error:
+            self.fail(str(error), param, ctx)
+        if quantity < 0:
+            self.fail(f"{value!r}: must not be negative", param, ctx)
+        return quantity
+
+
 class CropType(click.ParamType):
     """``X0:X1`` or ``X0:X1,Y0:Y1`` (lengths; an empty end is open) → ((x0, x1), (y0, y1) or None)."""
 
@@ -108,21 +131,29 @@ def crop_option(command):
     return click.option("--crop", type=CROP, help="Evaluate only X0:X1 (and Y0:Y1 for maps), e.g. 468um:733um; positions include the origin.")(wrapper)
 
 
-def input_options(spacing_flag="--spacing"):
+def input_options(spacing_flag="--spacing", most=1):
     """INPUT plus ``--spacing`` (under ``spacing_flag``), ``--unit`` and
     ``--ignore-checksums``; the command receives ``surface`` (the surface read) and
-    ``input`` (the name given)."""
+    ``input`` (the name given). With ``most`` > 1 the command takes up to that many
+    inputs (default ``-``) and receives the lists ``surfaces`` and ``inputs``."""
 
     def decorate(command):
         @functools.wraps(command)
         def wrapper(*args, input, spacing, unit, ignore_checksums, **kwargs):
             from ..io import read
 
-            surface = read(input, spacing=spacing, unit=unit, verify=not ignore_checksums)
-            return command(*args, surface=surface, input=input, **kwargs)
+            names = (input or ("-",)) if most > 1 else (input,)
+            if len(names) > most:
+                raise click.UsageError(f"give at most {most} inputs, not {len(names)}")
+            surfaces = [read(name, spacing=spacing, unit=unit, verify=not ignore_checksums) for name in names]
+            if most > 1:
+                return command(*args, surfaces=surfaces, inputs=list(names), **kwargs)
+            return command(*args, surface=surfaces[0], input=input, **kwargs)
 
+        argument = (click.argument("input", nargs=-1, metavar=f"[INPUT]{' [INPUT]' * (most - 1)}") if most > 1
+                    else click.argument("input", default="-", metavar="[INPUT]"))
         decorators = [
-            click.argument("input", default="-", metavar="[INPUT]"),
+            argument,
             click.option(spacing_flag, "spacing", type=SPACING, help="Spacing of input data that carry none (NPY, a column of heights), e.g. 1um or 1um,2um; overrides a file's own."),
             click.option("--unit", metavar="UNIT", help="Length unit of text values that name none (default m)."),
             click.option("--ignore-checksums", is_flag=True, help="Read X3P files whose MD5 checksums fail, with a warning."),

@@ -1,0 +1,122 @@
+"""Contact between the stylus and the profile (MATH.md §5.2), in SI units.
+
+Forces are those on the stylus and so on the hand: F_y up positive, F_x along +x.
+Both models return ``(F_x, F_y, contact)`` from the stylus position ``x``, the surface
+under it ``(h, h', h'')`` and the hand's state (``y`` its height, ``vx``, ``vy`` its
+velocity, ``ax`` its horizontal acceleration).
+
+* :class:`QuasiStatic` (default; the paper's experiment, M and C negligible):
+  ``F_y = K (h - y)`` while ``y <= h``, else 0, and ``F_x = -F_y h'``: the lateral force
+  resists climbing (the sources print the opposite sign, the force on the surface).
+* :class:`DynamicStylus`: a stylus of mass M hangs from the hand on the spring K and
+  damper C. In contact its tip follows the surface and the constraint force is
+  ``F = M ÿ_s - K (y - y_s) - C (ẏ - ẏ_s)`` with ``ÿ_s = h'' ẋ² + h' ẍ``, where h'' is
+  the mean curvature over the path of the last tick (the change of slope over the
+  distance moved), so that a corner narrower than one tick's travel still loads the
+  stylus instead of slipping between two samples of h''; contact is
+  lost when that force would pull (F < 0), and regained, plastically, when the tip
+  reaches the surface again. In free flight the stylus ODE is integrated exactly
+  (matrix exponential, zero-order hold) in sub-steps, so it is stable for any M, K
+  and C at any loop rate. The hand feels the coupling force ``K (y_s - y) + C (ẏ_s - ẏ)``.
+"""
+
+import math
+
+import numpy as np
+
+STIFFNESS = 1280.0  # N/m: the paper's 1.28 N/mm
+STYLUS_MASS = 1.85e-3  # kg: the slides' "1.85e-6" read in N·s²/mm (MATH.md §5.3)
+STYLUS_DAMPING = 0.046  # N·s/m: the slides' 4.6e-5 N/(mm/s)
+MAX_FORCE = 8.9  # N: the Impulse Engine 2000
+
+
+class QuasiStatic:
+    """The penalty wall along the profile with Minsky's lateral-gradient term."""
+
+    def __init__(self, stiffness=STIFFNESS):
+        if not stiffness > 0:
+            raise ValueError("the contact stiffness must be positive")
+        self.stiffness = float(stiffness)
+
+    def reset(self, y=None):
+        """No state to reset."""
+
+    def step(self, x, h, slope, curvature, y, vx, vy, ax):
+        penetration = h - y
+        if penetration < 0.0:
+            return 0.0, 0.0, False
+        fy = self.stiffness * penetration
+        return -fy * slope, fy, True
+
+
+class DynamicStylus:
+    """The stylus with mass and damping, stepped once per servo ``period`` (s)."""
+
+    def __init__(self, stiffness=STIFFNESS, mass=STYLUS_MASS, damping=STYLUS_DAMPING, period=1e-3, substeps=10):
+        if not (stiffness > 0 and mass > 0 and damping >= 0 and period > 0 and substeps >= 1):
+            raise ValueError("the stylus needs positive stiffness, mass and period and a non-negative damping")
+        self.stiffness, self.mass, self.damping = float(stiffness), float(mass), float(damping)
+        self.substeps = int(substeps)
+        self.substep = period / substeps
+        self._flight = zero_order_hold(stiffness, damping, mass, self.substep)
+        self.reset()
+
+    def reset(self, y=None):
+        """Put the stylus at rest at height ``y``, free; with no ``y``, on the surface."""
+        self.position, self.velocity, self.touching = (0.0 if y is None else y), 0.0, y is None
+        self._path = None
+
+    def step(self, x, h, slope, curvature, y, vx, vy, ax):
+        k, c = self.stiffness, self.damping
+        if self._path is not None and abs(x - self._path[0]) > 1e-9:
+            curvature = (slope - self._path[1]) / (x - self._path[0])
+        self._path = (x, slope)
+        if not self.touching and self.position <= h:
+            self.touching = True
+            self.position, self.velocity = h, slope * vx
+        if self.touching:
+            tip, tip_velocity = h, slope * vx
+            load = self.mass * (curvature * vx * vx + slope * ax) - k * (y - tip) - c * (vy - tip_velocity)
+            self.position, self.velocity = tip, tip_velocity
+            if load >= 0.0:
+                return -load * slope, k * (tip - y) + c * (tip_velocity - vy), True
+            self.touching = False
+        fy = k * (self.position - y) + c * (self.velocity - vy)
+        self._fly(h, slope * vx, k * y + c * vy)
+        return 0.0, fy, False
+
+    def _fly(self, h, surface_rate, drive):
+        p11, p12, p21, p22, g1, g2 = self._flight
+        position, velocity = self.position, self.velocity
+        for j in range(1, self.substeps + 1):
+            position, velocity = p11 * position + p12 * velocity + g1 * drive, p21 * position + p22 * velocity + g2 * drive
+            ground = h + surface_rate * j * self.substep
+            if position <= ground:
+                self.touching = True
+                position, velocity = ground, surface_rate
+                break
+        self.position, self.velocity = position, velocity
+
+
+def zero_order_hold(stiffness, damping, mass, period):
+    """The exact step of ``m ẍ = F - k x - b ẋ`` over ``period`` with F held constant:
+    ``(Φ11, Φ12, Φ21, Φ22, Γ1, Γ2)`` such that ``x' = Φ11 x + Φ12 v + Γ1 F`` and
+    ``v' = Φ21 x + Φ22 v + Γ2 F``."""
+    from scipy.linalg import expm
+
+    augmented = np.zeros((3, 3))
+    augmented[0, 1] = 1.0
+    augmented[1, 0] = -stiffness / mass
+    augmented[1, 1] = -damping / mass
+    augmented[1, 2] = 1.0 / mass
+    step = expm(augmented * period)
+    return tuple(float(v) for v in (step[0, 0], step[0, 1], step[1, 0], step[1, 1], step[0, 2], step[1, 2]))
+
+
+def clamp(fx, fy, limit):
+    """Scale ``(fx, fy)`` down to magnitude ``limit`` (N) if it is larger, keeping its direction."""
+    magnitude = math.hypot(fx, fy)
+    if magnitude <= limit:
+        return fx, fy
+    scale = limit / magnitude
+    return fx * scale, fy * scale

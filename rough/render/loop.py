@@ -1,0 +1,256 @@
+"""The servo loop: read the device, compute the force, write it, once per period.
+
+Each tick reads the hand's position (and buttons), estimates its velocity and
+acceleration (backward differences through a first-order low-pass, ``velocity_cutoff``),
+looks up the surface under it, asks the contact model and the friction model for the
+force, clamps the force vector to ``max_force`` by scaling both components, ramps it in
+over ``ramp`` seconds at the start, and writes it. The trigger (button 1) switches
+between two surfaces on each press.
+
+Real time: ticks are paced by a deadline clock (sleep until 0.2 ms before the
+deadline, then spin), with the garbage collector paused and, where the system allows
+it, the loop's thread at real-time priority (SCHED_FIFO ``priority``), so that other
+processes cannot preempt it for milliseconds. A tick that starts a whole
+period or more late counts its deadlines as missed and the schedule skips them rather
+than bursting. A simulated device runs as fast as the machine allows unless
+``realtime`` is set. Safety: whatever ends the loop (its duration, Ctrl-C, an
+exception, a device error), the device is closed, which zeroes the force; a watchdog
+thread zeroes it too if the loop stalls for ``watchdog`` seconds.
+"""
+
+import array
+import dataclasses
+import gc
+import math
+import os
+import threading
+import time
+
+import numpy as np
+
+from ..errors import RoughError
+from .contact import MAX_FORCE, clamp
+
+SPIN = 2e-4  # s before each deadline spent spinning instead of sleeping
+TRACE_FIELDS = ("t", "x", "y_i", "h", "F_x", "F_y", "contact")
+
+
+class LoopStalled(RoughError):
+    """The watchdog found the loop stalled and zeroed the force."""
+
+
+@dataclasses.dataclass
+class Settings:
+    """What the loop needs besides the device, surfaces and models (SI units)."""
+
+    rate: float = 1000.0
+    duration: float = None
+    ramp: float = 0.0
+    max_force: float = MAX_FORCE
+    realtime: bool = True
+    velocity_cutoff: float = 100.0
+    watchdog: float = 0.05
+    priority: int = 50
+
+    @property
+    def period(self):
+        return 1.0 / self.rate
+
+
+@dataclasses.dataclass
+class Run:
+    """What a run did: the trace (a structured array with TRACE_FIELDS, one row per
+    tick), the tick start times and deadlines (real-time runs), and how it ended."""
+
+    trace: np.ndarray
+    ticks: int
+    wall_time: float
+    settings: Settings
+    starts: np.ndarray = None
+    deadlines: np.ndarray = None
+    missed: int = 0
+    switches: int = 0
+    ended_by: str = "duration"
+    speed: float = None
+    device: str = "sim"
+    scheduling: str = "unpaced"
+
+    def timing(self):
+        """Achieved rate (Hz), period jitter p50/p99/max (s), missed deadlines and the
+        largest lateness (s); for an unpaced run only the speed against real time."""
+        simulated = self.ticks * self.settings.period
+        timing = {"ticks": self.ticks, "simulated_time": simulated, "wall_time": self.wall_time,
+                  "realtime_factor": simulated / self.wall_time if self.wall_time > 0 else math.inf,
+                  "scheduling": self.scheduling}
+        if self.starts is not None and self.starts.size > 2:
+            periods = np.diff(self.starts)
+            jitter = np.abs(periods - self.settings.period)
+            timing.update(
+                rate=(self.starts.size - 1) / (self.starts[-1] - self.starts[0]),
+                jitter_p50=float(np.percentile(jitter, 50)),
+                jitter_p99=float(np.percentile(jitter, 99)),
+                jitter_max=float(jitter.max()),
+                missed_deadlines=self.missed,
+                max_lateness=float((self.starts - self.deadlines).max()),
+            )
+        return timing
+
+
+class _Watchdog(threading.Thread):
+    """Zeroes the device's force if the loop's tick count stops advancing."""
+
+    def __init__(self, device, timeout):
+        super().__init__(name="rough-render-watchdog", daemon=True)
+        self.device, self.timeout = device, timeout
+        self.tick, self.tripped = 0, False
+        self._done = threading.Event()
+
+    def run(self):
+        last = -1
+        while not self._done.wait(self.timeout):
+            if self.tick == last:
+                self.tripped = True
+                self.device.emergency_stop()
+                return
+            last = self.tick
+
+    def stop(self):
+        self._done.set()
+
+
+def run(device, tracks, model, friction=None, settings=None):
+    """Run the loop on ``device`` over ``tracks`` (one or two :class:`Track`; the
+    trigger switches between two) until ``settings.duration`` passes or Ctrl-C.
+    Returns a :class:`Run`; the device is closed (force zero) however the loop ends."""
+    settings = settings or Settings()
+    watchdog = None
+    if settings.realtime and getattr(device, "needs_watchdog", False):
+        watchdog = _Watchdog(device, settings.watchdog)
+    collector = gc.isenabled()
+    gc.collect()
+    gc.disable()
+    previous, scheduling = _raise_priority(settings.priority) if settings.realtime else (None, "unpaced")
+    loop = _Loop(device, tracks, model, friction, settings, watchdog)
+    try:
+        loop.spin()
+    except KeyboardInterrupt:
+        loop.ended_by = "interrupt"
+    finally:
+        if previous is not None:
+            os.sched_setscheduler(0, *previous)
+        if watchdog is not None:
+            watchdog.stop()
+        if collector:
+            gc.enable()
+        device.close()
+    loop.scheduling = scheduling
+    if watchdog is not None and watchdog.tripped:
+        raise LoopStalled(f"the servo loop stalled for more than {settings.watchdog * 1e3:g} ms; the force was zeroed")
+    return loop.result()
+
+
+def _raise_priority(priority):
+    """Put the calling thread at SCHED_FIFO ``priority``; returns the policy to restore
+    (or None) and what the loop got."""
+    if not priority or not hasattr(os, "sched_setscheduler"):
+        return None, "normal priority"
+    previous = (os.sched_getscheduler(0), os.sched_getparam(0))
+    try:
+        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(priority))
+    except OSError:
+        return None, "normal priority (real-time priority not permitted)"
+    return previous, f"SCHED_FIFO {priority}"
+
+
+class _Loop:
+    def __init__(self, device, tracks, model, friction, settings, watchdog):
+        self.device, self.tracks, self.model, self.friction = device, list(tracks), model, friction
+        self.settings, self.watchdog = settings, watchdog
+        self.rows, self.starts, self.deadlines = array.array("d"), [], []
+        self.ticks, self.missed, self.switches = 0, 0, 0
+        self.ended_by = "duration"
+        self.wall_time = 0.0
+        self.scheduling = "unpaced"
+
+    def spin(self):
+        s = self.settings
+        period, realtime, limit = s.period, s.realtime, s.max_force
+        total = None if s.duration is None else max(1, round(s.duration * s.rate))
+        ramp_ticks = s.ramp * s.rate
+        alpha = 1.0 - math.exp(-2.0 * math.pi * s.velocity_cutoff * period)
+        read, write, step = self.device.read, self.device.write, self.model.step
+        friction = self.friction.force if self.friction is not None else None
+        record = self.rows.extend
+        watchdog = self.watchdog
+        track = 0
+        at = self.tracks[track].at
+        x_last, y_last, buttons = read()
+        vx, vy = getattr(self.device, "velocity", (0.0, 0.0))
+        x_last, y_last, ax, pressed = x_last - vx * period, y_last - vy * period, 0.0, buttons & 1
+        clock, sleep = time.perf_counter, time.sleep
+        begin = clock()
+        deadline = begin
+        k = 0
+        try:
+            while total is None or k < total:
+                if realtime:
+                    now = clock()
+                    if now - deadline >= period:
+                        skipped = int((now - deadline) / period)
+                        self.missed += skipped
+                        deadline += skipped * period
+                    elif deadline - now > SPIN:
+                        sleep(deadline - now - SPIN)
+                    while clock() < deadline:
+                        pass
+                    self.starts.append(clock())
+                    self.deadlines.append(deadline)
+                    deadline += period
+                    if watchdog is not None:
+                        if watchdog.tripped:
+                            break
+                        watchdog.tick = k
+                        if k == 1:
+                            watchdog.start()
+                x, y, buttons = read()
+                fresh = vx + alpha * ((x - x_last) / period - vx)
+                ax += alpha * ((fresh - vx) / period - ax)
+                vx = fresh
+                vy += alpha * ((y - y_last) / period - vy)
+                x_last, y_last = x, y
+                if buttons & 1 and not pressed and len(self.tracks) > 1:
+                    track = 1 - track
+                    at = self.tracks[track].at
+                    self.model.reset()
+                    self.switches += 1
+                pressed = buttons & 1
+                h, slope, curvature = at(x)
+                fx, fy, contact = step(x, h, slope, curvature, y, vx, vy, ax)
+                if friction is not None:
+                    tangential = friction(contact, x, vx, period)
+                    if tangential:
+                        norm = 1.0 / math.sqrt(1.0 + slope * slope)
+                        fx += tangential * norm
+                        fy += tangential * slope * norm
+                fx, fy = clamp(fx, fy, limit)
+                if k < ramp_ticks:
+                    fx, fy = fx * k / ramp_ticks, fy * k / ramp_ticks
+                write(fx, fy)
+                record((k * period, x, y, h, fx, fy, contact))
+                k += 1
+        finally:
+            self.ticks = k
+            self.wall_time = clock() - begin
+
+    def result(self):
+        columns = np.frombuffer(self.rows, dtype=np.float64).reshape(-1, len(TRACE_FIELDS))
+        trace = np.empty(len(columns), dtype=[(name, np.float64) for name in TRACE_FIELDS[:-1]] + [("contact", np.bool_)])
+        for index, name in enumerate(TRACE_FIELDS):
+            trace[name] = columns[:, index]
+        trace["h"][~np.isfinite(trace["h"])] = np.nan
+        if self.starts:
+            trace["t"] = np.asarray(self.starts[: trace.size]) - self.starts[0]
+        starts = np.asarray(self.starts) if self.starts else None
+        deadlines = np.asarray(self.deadlines) if self.deadlines else None
+        return Run(trace, self.ticks, self.wall_time, self.settings, starts, deadlines, self.missed, self.switches,
+                   self.ended_by, scheduling=self.scheduling)
