@@ -53,6 +53,7 @@ bench: $(BIN)/.installed
 	$(BIN)/python bench/bench_metrology.py
 	$(BIN)/python bench/bench_fractal.py
 	$(BIN)/python bench/bench_render.py
+	$(BIN)/python bench/bench_tip.py
 
 clean:
 	rm -rf build $(VENV) *.egg-info .pytest_cache .hypothesis

@@ -70,6 +70,23 @@ class QuantityType(click.ParamType):
         return quantity
 
 
+class TipType(LengthType):
+    """A tip radius: a length, or a preset (``needle`` 0.05 mm, ``fingernail`` 0.5 mm,
+    ``fingertip`` 8 mm) → metres."""
+
+    name = "RADIUS|needle|fingernail|fingertip"
+
+    def convert(self, value, param, ctx):
+        from ..metrology.tip import PRESETS
+
+        if isinstance(value, str) and value.strip().lower() in PRESETS:
+            return PRESETS[value.strip().lower()]
+        radius = super().convert(value, param, ctx)
+        if radius <= 0:
+            self.fail(f"{value!r}: a tip radius must be positive", param, ctx)
+        return radius
+
+
 class CropType(click.ParamType):
     """``X0:X1`` or ``X0:X1,Y0:Y1`` (lengths; an empty end is open) → ((x0, x1), (y0, y1) or None)."""
 
@@ -111,6 +128,7 @@ class FrequencyRangeType(click.ParamType):
 
 
 LENGTH = LengthType()
+TIP = TipType()
 SPACING = SpacingType()
 CROP = CropType()
 BAND = FrequencyRangeType()

@@ -2,7 +2,7 @@
 
 import click
 
-from .options import CROP, LENGTH, SPACING, QuantityType, input_options, report_format
+from .options import CROP, LENGTH, SPACING, TIP, QuantityType, input_options, report_format
 from .report import emit
 
 FORCE, STIFFNESS, DAMPING = QuantityType("force", "N"), QuantityType("stiffness", "N/mm"), QuantityType("damping", "N*s/m")
@@ -35,6 +35,9 @@ MASS, SPEED, TIME, RATE = QuantityType("mass", "g"), QuantityType("speed", "mm/s
 @click.option("--row", type=LENGTH, help="Maps: render the row at this y position (default the middle row).")
 @click.option("--crop", "window", type=CROP, help="The profile window X0:X1 to render (lengths; positions include the origin).")
 @click.option("--fill", is_flag=True, help="Fill invalid points first (linear interpolation).")
+@click.option("--tip", type=TIP,
+              help="Render what a round probe of this radius traces instead of the raw profile: a radius, or the "
+                   "presets needle (0.05 mm, a hypodermic needle), fingernail (0.5 mm), fingertip (8 mm).")
 @click.option("--stick-span", type=SPACING, metavar="X,Y",
               help="hid: lengths the stick's full x and y travel cover (default: the window, and 4× the profile's height range).")
 @click.option("--invert", type=click.Choice(["x", "y"]), multiple=True, help="hid: reverse an axis (position and force).")
@@ -48,7 +51,7 @@ MASS, SPEED, TIME, RATE = QuantityType("mass", "g"), QuantityType("speed", "mm/s
 @click.option("--plot", metavar="FILE", help="Draw the force profiles.")
 @report_format
 def render(surfaces, inputs, device, speeds, duration, rate, model, stiffness, mass, damping, friction, max_force, press,
-           hand_mass, hand_damping, hand_stiffness, row, window, fill, stick_span, invert, ramp, realtime,
+           hand_mass, hand_damping, hand_stiffness, row, window, fill, tip, stick_span, invert, ramp, realtime,
            velocity_filter, watchdog, priority, trace, plot, as_json, as_tsv):
     """Run the haptic contact loop on the profile INPUT (default: standard input): a
     virtual stylus rides the profile and the contact force (F_y = K·penetration,
@@ -64,6 +67,7 @@ def render(surfaces, inputs, device, speeds, duration, rate, model, stiffness, m
             | rough render --speed 20mm/s --speed 60mm/s --speed 120mm/s --trace forces-{speed}.tsv --plot forces.png
         rough render --model dynamic --friction karnopp:static=0.8N,coulomb=0.5N rock.x3p
         rough render --device hid --stick-span 80mm,10mm rough.x3p smooth.x3p
+        rough render --tip fingertip --speed 60mm/s fossil.x3p
     """
     from ..errors import InputError
     from ..render import Settings, Track
@@ -83,6 +87,10 @@ def render(surfaces, inputs, device, speeds, duration, rate, model, stiffness, m
             from ..fractal.resample import filled
 
             surface = surface.derive("fill", {}, heights=filled(surface))
+        if tip is not None:
+            from ..metrology.tip import traced
+
+            surface = traced(surface, tip)
         tracks.append(Track.from_surface(surface, row=row))
     if duration is not None and duration <= 0:
         raise InputError("--duration must be positive")
