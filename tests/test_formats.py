@@ -116,6 +116,18 @@ def test_gsf_padding_and_units(title):
     np.testing.assert_allclose(surface.heights, np.arange(6.0).reshape(2, 3) * UM)
 
 
+def test_gsf_titles_with_control_characters_keep_the_header_intact():
+    """Found by the round-trip property test: a NUL in a title ended the GSF header early."""
+    from rough import Surface
+
+    surface = Surface(np.zeros((2, 3)), (0.0625, 0.0625), metadata={"title": "a\x00b\nc"})
+    buffer = io.BytesIO()
+    surface.write(buffer, "gsf")
+    back = read_bytes(buffer.getvalue())
+    assert back.metadata["title"] == "a\x00b\nc" and back.heights.shape == (2, 3)
+    assert b"Title = a b c\n" in buffer.getvalue()
+
+
 def test_gsf_one_row_is_a_profile():
     surface = read_bytes(gsf(["XRes = 4", "YRes = 1", "XReal = 4e-6"], [1, 2, 3, 4]))
     assert surface.is_profile and surface.spacing == pytest.approx((1e-6,))

@@ -107,4 +107,6 @@ def _extras(header):
 
 
 def _one_line(text):
-    return " ".join(str(text).split())
+    """Header-safe text: no line breaks, NULs or other control characters (the exact
+    title travels in rough.metadata)."""
+    return " ".join("".join(c if c.isprintable() else " " for c in str(text)).split())
