@@ -44,6 +44,14 @@ demo: $(BIN)/.installed
 	@echo
 	@echo '$$ rough render --speed 20mm/s --speed 120mm/s --plot $(DEMO)/forces.png sample_profiles/rock-profile.tsv   (the simulated hand)'
 	@$(BIN)/rough render --speed 20mm/s --speed 120mm/s --plot $(DEMO)/forces.png sample_profiles/rock-profile.tsv
+	@echo
+	@rm -rf $(DEMO)/study
+	@echo '$$ rough experiment design --preset costa2000 --subjects 6 --seed 1 $(DEMO)/study'
+	@$(BIN)/rough experiment design --preset costa2000 --subjects 6 --seed 1 $(DEMO)/study
+	@echo '$$ rough experiment run $(DEMO)/study --subject S0N --observer rq=12,dimension=-4,spread=0.5   (N = 1 … 6, headless)'
+	@for s in S01 S02 S03 S04 S05 S06; do $(BIN)/rough experiment run $(DEMO)/study --subject $$s --observer rq=12,dimension=-4,spread=0.5; done
+	@echo '$$ rough experiment analyze $(DEMO)/study --set 1 --plot $(DEMO)/figure4.png'
+	@$(BIN)/rough experiment analyze $(DEMO)/study --set 1 --plot $(DEMO)/figure4.png
 
 test: $(BIN)/.installed
 	$(BIN)/python -m pytest -q

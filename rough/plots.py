@@ -2,6 +2,7 @@
 needed). Each function returns a matplotlib Figure; :func:`save` writes one
 atomically in the format of the file's extension (png, pdf, svg, ...)."""
 
+import math
 import os
 
 import numpy as np
@@ -149,3 +150,41 @@ def _shade(axis, x, mask):
     edges = np.flatnonzero(np.diff(np.concatenate(([0], mask.astype(np.int8), [0]))))
     for start, stop in zip(edges[::2], edges[1::2]):
         axis.axvspan(x[start], x[min(stop, x.size - 1)], color="0.85", lw=0)
+
+
+def percentage_figure(study, set_ids):
+    """For each reference set, the percentage of answers that judged each test surface
+    rougher than the reference, grouped by Rq and coloured by D (the paper's Figures
+    4 and 5)."""
+    from .experiment.analysis import percentages
+
+    plt = _pyplot()
+    figure, axes = plt.subplots(1, len(set_ids), figsize=(5.5 * len(set_ids), 4.2), squeeze=False)
+    for axis, set_id in zip(axes[0], set_ids):
+        cells = percentages(study, set_id)
+        entry = next(s for s in study.sets if s["id"] == set_id)
+        reference = study.surfaces[entry["reference"]]
+        levels_rq = sorted({round(rq, 12) for _, _, rq, _, _ in cells} | {round(reference["rq"], 12)})
+        levels_d = sorted({d for _, d, _, _, _ in cells} | {reference["dimension"]})
+        width = 0.8 / len(levels_d)
+        colours = plt.get_cmap("viridis")(np.linspace(0.15, 0.85, len(levels_d)))
+        for k, dimension in enumerate(levels_d):
+            label = f"D = {dimension:g}"
+            for g, rq in enumerate(levels_rq):
+                cell = next((c for c in cells if math.isclose(c[1], dimension) and math.isclose(c[2], rq, rel_tol=1e-6)), None)
+                if cell is None:
+                    continue
+                x = g + (k - (len(levels_d) - 1) / 2) * width
+                axis.bar(x, cell[3], width, color=colours[k], label=label)
+                axis.text(x, cell[3] + 1, f"{cell[3]:.0f}", ha="center", fontsize=7)
+                label = None
+        axis.axhline(50, color="0.5", lw=0.8, ls="--")
+        axis.set_xticks(range(len(levels_rq)), [f"Rq {rq * 1e3:.4g} mm" for rq in levels_rq])
+        axis.set_ylim(0, 110)
+        axis.set_ylabel("judged rougher than the reference (%)")
+        axis.set_title(f"set {set_id}: reference D = {reference['dimension']:g}, Rq = {reference['rq'] * 1e3:.4g} mm", fontsize=9)
+        handles, labels = axis.get_legend_handles_labels()
+        unique = dict(zip(labels, handles))
+        axis.legend(unique.values(), unique.keys(), fontsize=7, loc="upper left")
+    figure.tight_layout()
+    return figure

@@ -138,9 +138,9 @@ def timestamp():
     """Now (or ``SOURCE_DATE_EPOCH``) as an ISO 8601 UTC string to the second."""
     epoch = os.environ.get("SOURCE_DATE_EPOCH")
     moment = (
-        datetime.datetime.fromtimestamp(int(epoch), datetime.UTC)
+        datetime.datetime.fromtimestamp(int(epoch), datetime.timezone.utc)
         if epoch and epoch.isdigit()
-        else datetime.datetime.now(datetime.UTC)
+        else datetime.datetime.now(datetime.timezone.utc)
     )
     return moment.strftime("%Y-%m-%dT%H:%M:%SZ")
 

@@ -26,6 +26,7 @@ COMMANDS = {
     "resample": "rough.cli.resample:resample",
     "rose": "rough.cli.rose:rose",
     "render": "rough.cli.render:render",
+    "experiment": "rough.cli.experiment:experiment",
 }
 
 log = logging.getLogger("rough")

@@ -74,6 +74,7 @@ class Run:
     speed: float = None
     device: str = "sim"
     scheduling: str = "unpaced"
+    answer: object = None
 
     def timing(self):
         """Achieved rate (Hz), period jitter p50/p99/max (s), missed deadlines and the
@@ -118,19 +119,19 @@ class _Watchdog(threading.Thread):
         self._done.set()
 
 
-def run(device, tracks, model, friction=None, settings=None):
+def run(device, tracks, model, friction=None, settings=None, until=None):
     """Run the loop on ``device`` over ``tracks`` (one or two :class:`Track`; the
-    trigger switches between two) until ``settings.duration`` passes or Ctrl-C.
-    Returns a :class:`Run`; the device is closed (force zero) however the loop ends."""
+    trigger switches between two) until ``settings.duration`` passes, ``until(buttons)``
+    returns something true (kept as ``Run.answer``) or Ctrl-C. Returns a :class:`Run`;
+    the device is closed (force zero) however the loop ends."""
     settings = settings or Settings()
     watchdog = None
     if settings.realtime and getattr(device, "needs_watchdog", False):
         watchdog = _Watchdog(device, settings.watchdog)
     collector = gc.isenabled()
-    gc.collect()
     gc.disable()
     previous, scheduling = _raise_priority(settings.priority) if settings.realtime else (None, "unpaced")
-    loop = _Loop(device, tracks, model, friction, settings, watchdog)
+    loop = _Loop(device, tracks, model, friction, settings, watchdog, until)
     try:
         loop.spin()
     except KeyboardInterrupt:
@@ -163,8 +164,9 @@ def _raise_priority(priority):
 
 
 class _Loop:
-    def __init__(self, device, tracks, model, friction, settings, watchdog):
+    def __init__(self, device, tracks, model, friction, settings, watchdog, until):
         self.device, self.tracks, self.model, self.friction = device, list(tracks), model, friction
+        self.until, self.answer = until, None
         self.settings, self.watchdog = settings, watchdog
         self.rows, self.starts, self.deadlines = array.array("d"), [], []
         self.ticks, self.missed, self.switches = 0, 0, 0
@@ -181,7 +183,7 @@ class _Loop:
         read, write, step = self.device.read, self.device.write, self.model.step
         friction = self.friction.force if self.friction is not None else None
         record = self.rows.extend
-        watchdog = self.watchdog
+        watchdog, until = self.watchdog, self.until
         track = 0
         at = self.tracks[track].at
         x_last, y_last, buttons = read()
@@ -213,6 +215,11 @@ class _Loop:
                         if k == 1:
                             watchdog.start()
                 x, y, buttons = read()
+                if until is not None:
+                    self.answer = until(buttons)
+                    if self.answer:
+                        self.ended_by = "answer"
+                        break
                 fresh = vx + alpha * ((x - x_last) / period - vx)
                 ax += alpha * ((fresh - vx) / period - ax)
                 vx = fresh
@@ -253,4 +260,4 @@ class _Loop:
         starts = np.asarray(self.starts) if self.starts else None
         deadlines = np.asarray(self.deadlines) if self.deadlines else None
         return Run(trace, self.ticks, self.wall_time, self.settings, starts, deadlines, self.missed, self.switches,
-                   self.ended_by, scheduling=self.scheduling)
+                   self.ended_by, scheduling=self.scheduling, answer=self.answer)

@@ -1,0 +1,94 @@
+"""Options shared by the commands that drive a haptic device (render, experiment run):
+the device, the contact and friction models, the servo loop's settings."""
+
+import dataclasses
+import functools
+
+import click
+
+from .options import SPACING, QuantityType
+
+FORCE, STIFFNESS, DAMPING = QuantityType("force", "N"), QuantityType("stiffness", "N/mm"), QuantityType("damping", "N*s/m")
+MASS, SPEED, TIME, RATE = QuantityType("mass", "g"), QuantityType("speed", "mm/s"), QuantityType("time", "s"), QuantityType("rate", "Hz")
+
+
+@dataclasses.dataclass(frozen=True)
+class Haptics:
+    """The device and loop options as given (SI units)."""
+
+    device: str
+    rate: float
+    model: str
+    stiffness: float
+    mass: float
+    damping: float
+    friction: str
+    max_force: float
+    stick_span: tuple
+    invert: tuple
+    ramp: float
+    velocity_filter: float
+    watchdog: float
+    priority: int
+
+    @property
+    def simulated(self):
+        return self.device == "sim"
+
+    def contact(self):
+        from ..render.session import make_model
+
+        return make_model(self.model, self.stiffness, self.mass, self.damping, 1.0 / self.rate)
+
+    def friction_model(self):
+        from ..render.friction import parse_friction
+
+        return parse_friction(self.friction)
+
+    def settings(self, duration=None, realtime=False):
+        from ..render import Settings
+
+        ramp = self.ramp if self.ramp is not None else (0.0 if self.simulated else 0.5)
+        return Settings(rate=self.rate, duration=duration, max_force=self.max_force, velocity_cutoff=self.velocity_filter,
+                        watchdog=self.watchdog, priority=self.priority, ramp=ramp, realtime=realtime or not self.simulated)
+
+
+def haptic_options(command):
+    """Adds the device, model and loop options; the command receives ``haptics``."""
+    names = [field.name for field in dataclasses.fields(Haptics)]
+
+    @functools.wraps(command)
+    def wrapper(*args, **kwargs):
+        values = {name: kwargs.pop(name) for name in names}
+        if values["device"] != "sim" and not values["device"].startswith("hid"):
+            raise click.BadParameter(f"{values['device']!r}: use sim, hid or hid:VID:PID", param_hint="--device")
+        return command(*args, haptics=Haptics(**values), **kwargs)
+
+    options = [
+        click.option("--device", default="sim", show_default=True, metavar="sim|hid[:VID:PID]",
+                     help="sim: a simulated hand; hid: the first HID PID force-feedback joystick (or the one with these hex IDs)."),
+        click.option("--rate", type=RATE, default="1kHz", show_default=True, help="Servo rate."),
+        click.option("--model", type=click.Choice(["quasi-static", "dynamic"]), default="quasi-static", show_default=True,
+                     help="quasi-static: F = K·penetration (M, C negligible); dynamic: the stylus with mass and damping."),
+        click.option("--stiffness", type=STIFFNESS, default="1.28N/mm", show_default=True, help="Contact stiffness K."),
+        click.option("--mass", type=MASS, default="1.85g", show_default=True,
+                     help="dynamic: stylus mass M (the slides' 1.85e-6 in N·s²/mm = 1.85 g; they print 1.85e-6 g, MATH §5.3)."),
+        click.option("--damping", type=DAMPING, default="4.6e-5N*s/mm", show_default=True, help="dynamic: stylus damping C."),
+        click.option("--friction", metavar="MODEL[:k=v,...]",
+                     help="coulomb:level=0.3N,viscous=2N*s/m | karnopp:static=0.8N,coulomb=0.5N,band=2mm/s,stiffness=1N/mm | "
+                          "dahl:stiffness=1N/mm,coulomb=0.5N (default none)."),
+        click.option("--max-force", type=FORCE, default="8.9N", show_default=True,
+                     help="Device maximum; the force vector is scaled to it."),
+        click.option("--stick-span", type=SPACING, metavar="X,Y",
+                     help="hid: lengths the stick's full x and y travel cover (default: the window, and 4× the profile's height range)."),
+        click.option("--invert", type=click.Choice(["x", "y"]), multiple=True, help="hid: reverse an axis (position and force)."),
+        click.option("--ramp", type=TIME, help="Ramp the force in over this time at the start (default: hid 0.5 s, sim none)."),
+        click.option("--velocity-filter", type=RATE, default="100Hz", show_default=True,
+                     help="Cut-off of the velocity estimate's low-pass filter."),
+        click.option("--watchdog", type=TIME, default="50ms", show_default=True, help="hid: zero the force if the loop stalls this long."),
+        click.option("--priority", type=click.IntRange(0, 99), default=50, show_default=True,
+                     help="Real-time loops: run at SCHED_FIFO priority N where permitted (0: normal scheduling)."),
+    ]
+    for option in reversed(options):
+        wrapper = option(wrapper)
+    return wrapper

@@ -1,0 +1,233 @@
+"""Running a subject's session: the remaining trials, one at a time, each answer saved
+before the next trial starts.
+
+The answers file ``answers/<subject>.csv`` is rewritten whole through a temporary file
+and a rename after every trial, so it always holds every answered trial and nothing
+half-written: a session killed at any moment resumes at the first unanswered trial,
+losing nothing and repeating nothing.
+
+On a joystick the subject feels the first surface of the pair; the trigger (button 1)
+toggles to the other; button 2 answers "the first is rougher", button 3 "the second";
+keys 1 and 2 on the keyboard do the same. With the simulated hand, a scripted
+:class:`~.observer.Observer` answers after the hand has stroked both surfaces.
+"""
+
+import csv
+import dataclasses
+import datetime
+import io
+import pathlib
+import sys
+import threading
+import time
+
+from ..errors import InputError
+from .design import TRIAL_FIELDS
+
+ANSWER_FIELDS = TRIAL_FIELDS + ("answer", "test_rougher", "reference_dimension", "reference_rq_m", "test_dimension",
+                                "test_rq_m", "response_time_s", "toggles", "device", "finished")
+ANSWER_BUTTONS = {2: "first", 4: "second"}  # button 2, button 3 (bit masks)
+ANSWER_KEYS = {"1": "first", "2": "second"}
+
+
+@dataclasses.dataclass
+class Progress:
+    """What a call to :func:`run_session` did."""
+
+    answered: int
+    remaining: int
+    total: int
+    interrupted: bool = False
+
+
+def read_answers(study, subject):
+    """The answered trials of ``subject`` (rows as dicts), checked against the design."""
+    path = study.answers_path(subject)
+    if not path.exists():
+        return []
+    try:
+        rows = list(csv.DictReader(io.StringIO(path.read_text())))
+    except (UnicodeError, csv.Error) as error:
+        raise InputError(f"{path}: not a readable answers file ({error})") from None
+    if rows and tuple(rows[0]) != ANSWER_FIELDS:
+        raise InputError(f"{path}: expected the columns {', '.join(ANSWER_FIELDS)}")
+    planned = {t["trial"]: t for t in study.trials_of(subject)}
+    seen = set()
+    for line, row in enumerate(rows, start=2):
+        try:
+            number, rougher = int(row["trial"]), int(row["test_rougher"])
+        except ValueError:
+            raise InputError(f"{path}, line {line}: trial and test_rougher must be whole numbers") from None
+        trial = planned.get(number)
+        if trial is None or number in seen or rougher not in (0, 1) or row["answer"] not in ("first", "second"):
+            raise InputError(f"{path}, line {line}: not an answer to a planned trial (or answered twice)")
+        if any(str(trial[key]) != row[key] for key in TRIAL_FIELDS):
+            raise InputError(f"{path}, line {line}: does not match trial {number} of trials.csv")
+        if (row["answer"] == ("first" if trial["first"] == trial["test"] else "second")) != bool(rougher):
+            raise InputError(f"{path}, line {line}: answer and test_rougher disagree")
+        seen.add(number)
+    return rows
+
+
+def run_session(study, subject, present, device_name):
+    """Present every unanswered trial of ``subject`` with ``present(trial)`` →
+    ``(answer, response_time_s, toggles)`` (answer ``first`` or ``second``; None when
+    the subject stopped), saving each answer at once. Ctrl-C pauses the session."""
+    answers = read_answers(study, subject)
+    done = {int(row["trial"]) for row in answers}
+    trials = study.trials_of(subject)
+    for trial in trials:
+        if trial["trial"] in done:
+            continue
+        try:
+            outcome = present(trial)
+        except KeyboardInterrupt:
+            outcome = None
+        if outcome is None:
+            return Progress(len(answers), len(trials) - len(answers), len(trials), interrupted=True)
+        answers.append(_answer_row(study, trial, *outcome, device_name))
+        _save(study.answers_path(subject), answers)
+    return Progress(len(answers), 0, len(trials))
+
+
+def _answer_row(study, trial, answer, seconds, toggles, device_name):
+    test, reference = study.surfaces[trial["test"]], study.surfaces[trial["reference"]]
+    rougher = int(trial[answer] == trial["test"])
+    return {**{key: trial[key] for key in TRIAL_FIELDS}, "answer": answer, "test_rougher": rougher,
+            "reference_dimension": reference["dimension"], "reference_rq_m": reference["rq"],
+            "test_dimension": test["dimension"], "test_rq_m": test["rq"], "response_time_s": f"{seconds:.3f}",
+            "toggles": toggles, "device": device_name,
+            "finished": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")}
+
+
+def _save(path, rows):
+    from ..io.atomic import atomic_output
+
+    pathlib.Path(path).parent.mkdir(exist_ok=True)
+    text = io.StringIO()
+    writer = csv.DictWriter(text, ANSWER_FIELDS, lineterminator="\n")
+    writer.writeheader()
+    writer.writerows(rows)
+    with atomic_output(path) as stream:
+        stream.write(text.getvalue().encode())
+
+
+def simulated_presenter(study, observer, speed, model, friction, settings, **hand):
+    """Present a trial with the simulated hand: one stroke over each surface, then the
+    observer's judgement from the design's D and Rq. Response time: the strokes' time."""
+    from .. import read
+    from ..render import Track, simulate
+
+    tracks = {}
+
+    def present(trial):
+        seconds = 0.0
+        for side in ("first", "second"):
+            name = trial[side]
+            if name not in tracks:
+                tracks[name] = Track.from_surface(read(study.surface_path(name)))
+            stroke = simulate(tracks[name], speed, model, friction, dataclasses.replace(settings), **hand)
+            if stroke.ended_by == "interrupt":
+                return None
+            seconds += stroke.timing()["simulated_time"]
+        test, reference = study.surfaces[trial["test"]], study.surfaces[trial["reference"]]
+        rougher = observer.judges_test_rougher(trial["subject"], trial["trial"], test["dimension"] - reference["dimension"],
+                                               test["rq"] - reference["rq"])
+        test_side = "first" if trial["first"] == trial["test"] else "second"
+        return (test_side if rougher else ("second" if test_side == "first" else "first")), seconds, 1
+
+    return present
+
+
+class HeldOpen:
+    """A device whose ``close`` only zeroes the force, so one joystick serves many trials."""
+
+    def __init__(self, device):
+        self.device = device
+        self.needs_watchdog = getattr(device, "needs_watchdog", False)
+
+    def read(self):
+        return self.device.read()
+
+    def write(self, fx, fy):
+        self.device.write(fx, fy)
+
+    def emergency_stop(self):
+        self.device.emergency_stop()
+
+    def close(self):
+        self.device.write(0.0, 0.0)
+
+
+class Keyboard:
+    """Keys 1 and 2 from standard input, read by a background thread (single key
+    presses on a terminal, lines otherwise)."""
+
+    def __init__(self):
+        self.key = None
+        self._restore = None
+        if sys.stdin is None:
+            return
+        if sys.stdin.isatty():
+            import termios
+            import tty
+
+            descriptor = sys.stdin.fileno()
+            saved = termios.tcgetattr(descriptor)
+            tty.setcbreak(descriptor)
+            self._restore = lambda: termios.tcsetattr(descriptor, termios.TCSADRAIN, saved)
+        threading.Thread(target=self._listen, daemon=True, name="rough-keyboard").start()
+
+    def _listen(self):
+        while True:
+            character = sys.stdin.read(1)
+            if not character:
+                return
+            if character in ANSWER_KEYS:
+                self.key = ANSWER_KEYS[character]
+
+    def take(self):
+        key, self.key = self.key, None
+        return key
+
+    def close(self):
+        if self._restore is not None:
+            self._restore()
+
+
+def joystick_presenter(study, joystick, model, friction, settings, keyboard):
+    """Present a trial on the joystick until the subject answers (the surfaces are read
+    before the first trial, so trials follow each other without a pause)."""
+    from .. import read
+    from ..render import Track
+    from ..render.loop import run
+
+    held = HeldOpen(joystick)
+    tracks = {name: Track.from_surface(read(study.surface_path(name))) for name in study.surfaces}
+
+    def answered(buttons):
+        for mask, answer in ANSWER_BUTTONS.items():
+            if buttons & mask:
+                return answer
+        return keyboard.take()
+
+    def present(trial):
+        pair = [tracks[trial["first"]], tracks[trial["second"]]]
+        keyboard.take()
+        model.reset()
+        started = time.monotonic()
+        result = run(held, pair, model, friction, dataclasses.replace(settings, duration=None), until=answered)
+        if result.ended_by != "answer":
+            return None
+        _wait_for_release(held)
+        return result.answer, time.monotonic() - started, result.switches
+
+    return present
+
+
+def _wait_for_release(device, timeout=5.0):
+    """Wait (force zero) until the answer button is let go, so it does not answer the next trial too."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline and device.read()[2] & (2 | 4):
+        device.write(0.0, 0.0)
+        time.sleep(0.005)
