@@ -6,7 +6,7 @@ VENV ?= .venv
 BIN = $(VENV)/bin
 DEMO = build/demo
 
-.PHONY: demo test bench clean
+.PHONY: demo test bench fuzz clean
 
 $(BIN)/.installed: setup.cfg pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -62,6 +62,10 @@ bench: $(BIN)/.installed
 	$(BIN)/python bench/bench_fractal.py
 	$(BIN)/python bench/bench_render.py
 	$(BIN)/python bench/bench_tip.py
+
+fuzz: $(BIN)/.installed
+	$(BIN)/python -m pip install --quiet -e '.[fuzz]'
+	$(BIN)/python bench/fuzz_readers.py -runs=1000000 -max_len=8192 -timeout=10
 
 clean:
 	rm -rf build $(VENV) *.egg-info .pytest_cache .hypothesis

@@ -7,6 +7,7 @@ Conventions (SPEC §3): heights are float64 metres, a profile is ``z[x]`` and a 
 
 import dataclasses
 import datetime
+import math
 import os
 from dataclasses import dataclass, field
 
@@ -14,6 +15,16 @@ import numpy as np
 
 from . import __version__
 from .errors import InputError
+
+MAX_POINTS = 1 << 28  # 16384 × 16384: with its spectrum, about 6 GiB of working memory
+
+
+def check_size(shape, what):
+    """Refuse to make a surface of ``shape`` past :data:`MAX_POINTS` (before allocating it)."""
+    points = math.prod(shape)
+    if points > MAX_POINTS:
+        raise InputError(f"{what} would hold {points:,} points, more than rough's limit of {MAX_POINTS:,} "
+                         "(16384 × 16384); choose a coarser spacing or a smaller size")
 
 
 @dataclass(frozen=True)

@@ -367,3 +367,110 @@ def test_render_without_a_joystick_says_so():
     profile = rough("synth", "--length", "5mm", "--dimension", "1.3", "--rq", "0.1mm", "--seed", "2", check=True).stdout
     result = rough("render", "--device", "hid:dead:beef", "--duration", "1s", input=profile)
     assert_one_line_error(result, "no force-feedback joystick found", status=1)
+
+
+# -- faults: the force stays bounded and goes to zero ----------------------------------------------
+
+
+class TimedDevice(ScriptedDevice):
+    """Records when each force was written."""
+
+    def __init__(self, *args, spin_at=None, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.times, self.spin_at = [], spin_at
+
+    def read(self):
+        if self.k == self.spin_at:
+            until = time.monotonic() + 0.3
+            while time.monotonic() < until:  # stuck in Python code, holding the interpreter
+                pass
+        return super().read()
+
+    def write(self, fx, fy):
+        self.times.append(time.monotonic())
+        super().write(fx, fy)
+
+    def emergency_stop(self):
+        self.times.append(time.monotonic())
+        super().emergency_stop()
+
+    def close(self):
+        self.times.append(time.monotonic())
+        super().close()
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.lists(st.tuples(st.floats(-1.0, 1.0) | st.sampled_from([math.nan, math.inf, -math.inf]),
+                          st.floats(-1.0, 1.0) | st.sampled_from([math.nan, math.inf, -math.inf])), min_size=2, max_size=40),
+       st.floats(0.5, 20.0))
+def test_every_written_force_is_finite_and_within_the_limit(positions, limit):
+    """Wild positions (deep in the surface, NaN, infinite) and friction: no force beyond
+    the limit, nothing non-finite ever reaches the device."""
+    device = ScriptedDevice([(x * 1e-2, y * 1e-2, 0) for x, y in positions])
+    friction = parse_friction("karnopp:static=5N,coulomb=3N,viscous=100N*s/m")
+    run(device, [RAISED], QuasiStatic(stiffness=1e6), friction, Settings(duration=len(positions) * 1e-3, max_force=limit, realtime=False))
+    forces_written = np.array(device.written)
+    assert np.isfinite(forces_written).all()
+    assert (np.hypot(forces_written[:, 0], forces_written[:, 1]) <= limit * (1 + 1e-12)).all()
+
+
+class Exploding(QuasiStatic):
+    def __init__(self, at):
+        super().__init__()
+        self.at, self.calls = at, 0
+
+    def step(self, *arguments):
+        self.calls += 1
+        if self.calls > self.at:
+            raise RuntimeError("model failure")
+        return super().step(*arguments)
+
+
+def test_an_exception_zeroes_the_force_at_once():
+    device = TimedDevice([(5e-3, -1e-3, 0)])
+    with pytest.raises(RuntimeError):
+        run(device, [FLAT], Exploding(25), None, Settings(duration=1.0, realtime=True, watchdog=1.0))
+    assert len(device.written) == 26 and device.written[24][1] > 0 and device.written[25] == (0.0, 0.0)
+    assert device.times[25] - device.times[24] < 2e-3  # within two ticks
+
+
+def test_a_stalled_loop_is_zeroed_within_two_ticks_of_its_watchdog():
+    """The loop gets stuck in Python code; with --watchdog 2ms (two ticks) the force is
+    zeroed within two ticks of the watchdog's deadline, though the loop holds the
+    interpreter, and nothing is written after."""
+    device = TimedDevice([(5e-3, -1e-3, 0)], spin_at=30)
+    device.needs_watchdog = True
+    with pytest.raises(LoopStalled):
+        run(device, [FLAT], QuasiStatic(), None, Settings(duration=2.0, watchdog=2e-3, realtime=True))
+    stop = device.written.index((0.0, 0.0))
+    assert stop == 30 and all(f[1] > 0 for f in device.written[:30])
+    stalled = device.times[29] + 1e-3  # the deadline of the tick that never came
+    assert device.times[30] - stalled < 2e-3 + 2e-3
+    assert all(f == (0.0, 0.0) for f in device.written[30:])
+
+
+def test_a_vanished_joystick_leaves_no_force():
+    """Reads fail (the device is going away) while writes still arrive: the zero is
+    written in the same tick; when writes fail too, closing does not raise."""
+    from pid_descriptor import Layout  # noqa: F401 -- the virtual device's layout
+    from virtual_joystick import FakeHandle, PidJoystick
+
+    from rough.render.hid import DeviceGone, Joystick
+
+    device = PidJoystick()
+    handle = FakeHandle(device)
+    handle.move(0.5, 0.2, 0)
+    stick = Joystick(handle, device.descriptor, 8.9, 0.0, 0.01, 1e-3, 4e-3)
+    original = handle.read
+    calls = {"n": 0}
+
+    def failing_read(size, timeout=0):
+        calls["n"] += 1
+        if calls["n"] > 40:
+            raise OSError("read error")
+        return original(size, timeout)
+
+    handle.read = failing_read
+    with pytest.raises(DeviceGone):
+        run(stick, [Track(np.full(101, 1e-3), 1e-4)], QuasiStatic(), None, Settings(duration=1.0, watchdog=1.0))
+    assert device.force() == (0.0, 0.0) and handle.closed

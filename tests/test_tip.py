@@ -10,6 +10,7 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
 from rough import Surface
+from rough.errors import InputError
 from rough.metrology.tip import PRESETS, closing_envelope, tip_profile, traced
 
 from conftest import assert_one_line_error, rough
@@ -160,6 +161,26 @@ def test_tips_below_the_sampling_change_nothing():
     assert tip_profile(4e-6, (1e-5,)).size == 1
     z = np.random.default_rng(2).normal(size=50) * 1e-5
     assert np.array_equal(traced(profile(z), 4e-6).heights, z)
+
+
+@pytest.mark.parametrize("shape", [(7,), (5, 6)])
+def test_a_tip_wider_than_the_scan_gives_what_the_unclipped_tip_gives(shape):
+    """Offsets past every sample never touch: clipping the kernel to the data changes nothing."""
+    from scipy import ndimage
+
+    z = np.random.default_rng(3).normal(size=shape) * 1e-5
+    radius, spacing = 3e-4, (DX,) * len(shape)
+    assert tip_profile(radius, spacing, shape).shape == tuple(2 * n - 1 for n in shape)
+    full = tip_profile(radius, spacing)
+    full = full - full[tuple(n // 2 for n in full.shape)]
+    expected = ndimage.grey_dilation(z, structure=full, mode="constant", cval=-np.inf)
+    np.testing.assert_allclose(traced(Surface(z, spacing), radius).heights, expected, rtol=0, atol=1e-18)
+
+
+def test_a_tip_that_would_take_hours_is_refused_with_a_hint():
+    nano = Surface(np.zeros((3000, 3000)), (1e-9, 1e-9))
+    with pytest.raises(InputError, match="coarser spacing"):
+        traced(nano, 5e-6)
 
 
 # -- the commands --------------------------------------------------------------------------------

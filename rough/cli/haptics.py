@@ -85,7 +85,7 @@ def haptic_options(command):
         click.option("--ramp", type=TIME, help="Ramp the force in over this time at the start (default: hid 0.5 s, sim none)."),
         click.option("--velocity-filter", type=RATE, default="100Hz", show_default=True,
                      help="Cut-off of the velocity estimate's low-pass filter."),
-        click.option("--watchdog", type=TIME, default="50ms", show_default=True, help="hid: zero the force if the loop stalls this long."),
+        click.option("--watchdog", type=TIME, default="10ms", show_default=True, help="hid: zero the force if the loop stalls this long."),
         click.option("--priority", type=click.IntRange(0, 99), default=50, show_default=True,
                      help="Real-time loops: run at SCHED_FIFO priority N where permitted (0: normal scheduling)."),
     ]

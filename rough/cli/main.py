@@ -11,6 +11,7 @@ import importlib
 import logging
 import os
 import sys
+import warnings
 
 import click
 
@@ -38,6 +39,11 @@ class PipeClosed(Exception):
     which click would turn into exit status 1)."""
 
 
+class Interrupted(Exception):
+    """Ctrl-C during a command (raised instead of KeyboardInterrupt, which click answers
+    with a blank line on standard error)."""
+
+
 class LazyGroup(click.Group):
     """A group whose subcommands are imported on first use."""
 
@@ -46,6 +52,8 @@ class LazyGroup(click.Group):
             return super().invoke(ctx)
         except BrokenPipeError as error:
             raise PipeClosed() from error
+        except KeyboardInterrupt as error:  # past click, which would print a blank line first
+            raise Interrupted() from error
 
     def list_commands(self, ctx):
         return sorted(COMMANDS)
@@ -85,6 +93,11 @@ def cli(quiet, verbose, debug):
     log.propagate = False
 
 
+def _warn_in_one_line(message, category, filename, lineno, file=None, line=None):
+    """A library's Python warning, as one 'warning:' line like rough's own."""
+    log.warning(str(message).splitlines()[0] if str(message) else category.__name__)
+
+
 class _Formatter(logging.Formatter):
     def format(self, record):
         kind = "warning: " if record.levelno >= logging.WARNING else ""
@@ -106,6 +119,11 @@ def run(args):
     from ..errors import RoughError
 
     debug = "--debug" in args
+    # numpy's RuntimeWarnings (invalid value, overflow) are noise on a command line: rough
+    # announces the NaN and infinities it produces itself
+    warnings.filterwarnings("ignore", category=RuntimeWarning, module=r"numpy(\.|$)")
+    warnings.filterwarnings("ignore", r"(invalid value|divide by zero|overflow) encountered", RuntimeWarning)
+    warnings.showwarning = _warn_in_one_line
     try:
         result = cli.main(args=args, prog_name="rough", standalone_mode=False)
         return result if isinstance(result, int) else 0
@@ -118,7 +136,7 @@ def run(args):
     except click.ClickException as error:
         _say(error.format_message())
         return error.exit_code
-    except (click.Abort, KeyboardInterrupt):
+    except (click.Abort, KeyboardInterrupt, Interrupted):
         _say("interrupted")
         return 130
     except (PipeClosed, BrokenPipeError):
@@ -127,6 +145,9 @@ def run(args):
     except RoughError as error:
         _report(error, debug)
         return error.exit_code
+    except MemoryError as error:
+        _report(error, debug, "out of memory: the surface is too large for this machine (crop it, or resample it coarser)")
+        return 1
     except OSError as error:
         where = f"{error.filename}: " if error.filename else ""
         _report(error, debug, f"{where}{error.strerror or error}")

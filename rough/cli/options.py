@@ -230,8 +230,13 @@ class Output:
             return
         if self.format in BINARY and sys.stdout.isatty():
             raise InputError(f"refusing to write binary {self.format.upper()} to a terminal: use -o FILE, a pipe, or -f tsv")
-        write(surface, sys.stdout.buffer, format=self.format)
-        sys.stdout.buffer.flush()
+        try:
+            write(surface, sys.stdout.buffer, format=self.format)
+            sys.stdout.buffer.flush()
+        except BrokenPipeError:
+            raise
+        except OSError as error:
+            raise OSError(error.errno, error.strerror, "standard output") from error
 
 
 def report_format(command):

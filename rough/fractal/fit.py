@@ -46,6 +46,7 @@ SAMPLINGS = ("point", "band-limited")
 BETA_RANGE = (1.0 + 1e-6, 3.0 - 1e-6)
 LOWEST_RING = 8
 RESAMPLED_TOP = 0.8
+FLAT = 1e-9  # RMS residual below this fraction of the largest height is rounding, not roughness
 
 
 @dataclasses.dataclass
@@ -111,7 +112,9 @@ def fit_fractal(surface, band=None, resolution=None, method="whittle", order=1, 
         fitter = {"whittle": _whittle_profile, "variogram": _variogram, "madogram": _madogram, "loglog": _loglog}[method]
         if method == "whittle" and (band is None or band[1] is None):
             band = ((band or (None, None))[0], default_top(surface, 0.5 / surface.spacing[0], sampling))
-        return fitter(detrend(surface, order=order).heights, surface.spacing[0], band, resolution, sampling)
+        levelled = detrend(surface, order=order).heights
+        refuse_flat(levelled, surface.heights)
+        return fitter(levelled, surface.spacing[0], band, resolution, sampling)
     if method != "whittle":
         raise InputError(f"maps are fitted by the Whittle method only, not {method}")
     return _whittle_map(surface, order, band, resolution, sampling, sector)
@@ -169,6 +172,13 @@ def _minimise(function):
 
     result = minimize_scalar(function, bounds=BETA_RANGE, method="bounded", options={"xatol": 1e-7})
     return float(result.x)
+
+
+def refuse_flat(residual, heights):
+    """Refuse a surface with no roughness left once its form is removed (a constant or
+    a plane): its spectrum is rounding noise, and any D fitted to it is meaningless."""
+    if not np.linalg.norm(residual) / math.sqrt(residual.size) > FLAT * np.max(np.abs(heights)):
+        raise InputError("the surface is flat once its form is removed: there is no roughness to fit")
 
 
 def at_fractal_edge(beta):
@@ -229,6 +239,7 @@ def _whittle_map(surface, order, band, resolution, sampling, sector):
     low = LOWEST_RING * step if low is None else low
     high = default_top(surface, nyquist, sampling) if high is None else high
     field, power = windowed_map(surface, order)
+    refuse_flat(field, surface.heights)
     rings = ring_spectrum(field, power, surface.spacing, low, high, step, sector)
     del field
     if rings["count"].size < 4:

@@ -19,10 +19,12 @@ set back to NaN in the result.
 """
 
 import fractions
+import math
 
 import numpy as np
 
 from ..errors import InputError
+from ..surface import check_size
 
 MAX_DENOMINATOR = 1000
 
@@ -37,21 +39,34 @@ def resample(surface, spacing, fill=False):
     invalid = np.isnan(surface.heights)
     if invalid.any() and not fill:
         raise InputError("the surface has invalid points; resampling needs them filled first (--fill)")
+    ratios = [_ratio(old, new) for old, new in zip(surface.spacing, targets)]
+    shape = surface.heights.shape
+    for axis, (ratio, new) in enumerate(zip(ratios, targets)):
+        if shape[-1 - axis] * ratio < 2:
+            raise InputError(f"a spacing of {new:g} m leaves fewer than two points along {'xy'[axis]}")
+    check_size([math.ceil(n * ratio) for n, ratio in zip(shape, reversed(ratios))], "the resampled surface")
     heights = filled(surface) if invalid.any() else surface.heights
     new_spacing = []
-    for axis, (old, new) in enumerate(zip(surface.spacing, targets)):
-        ratio = fractions.Fraction(old / new).limit_denominator(MAX_DENOMINATOR)
-        if abs(float(ratio) - old / new) > 1e-9 * old / new:
-            raise InputError(f"cannot resample {old:g} m to {new:g} m exactly with a ratio of small integers")
+    for axis, (old, ratio) in enumerate(zip(surface.spacing, ratios)):
         array_axis = heights.ndim - 1 - axis
-        if heights.shape[array_axis] * ratio < 2:
-            raise InputError(f"a spacing of {new:g} m leaves fewer than two points along {'xy'[axis]}")
         heights = resample_poly(heights, ratio.numerator, ratio.denominator, axis=array_axis, padtype="line")
         new_spacing.append(old / float(ratio))
     if invalid.any():
         heights = np.where(_nearest_invalid(invalid, surface.spacing, new_spacing, heights.shape), np.nan, heights)
     return surface.derive("resample", {"spacing": new_spacing, "filled": bool(invalid.any())},
                           heights=heights, spacing=tuple(new_spacing))
+
+
+def _ratio(old, new):
+    """old/new spacing as a fraction of integers up to MAX_DENOMINATOR (the polyphase
+    filter is 20 taps per unit of either: larger ones would outgrow the data)."""
+    ratio = fractions.Fraction(old / new).limit_denominator(MAX_DENOMINATOR)
+    if abs(float(ratio) - old / new) > 1e-9 * old / new:
+        raise InputError(f"cannot resample {old:g} m to {new:g} m exactly with a ratio of small integers")
+    if ratio.numerator > MAX_DENOMINATOR:
+        raise InputError(f"cannot refine {old:g} m to {new:g} m in one step (more than {MAX_DENOMINATOR}×); "
+                         "resample in steps, or synthesise the fine scales")
+    return ratio
 
 
 def filled(surface):

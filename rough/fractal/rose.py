@@ -25,7 +25,7 @@ import math
 import numpy as np
 
 from ..errors import InputError
-from .fit import LOWEST_RING, default_top, ring_fit, sampling_of, warn_at_edge
+from .fit import LOWEST_RING, default_top, refuse_flat, ring_fit, sampling_of, warn_at_edge
 from .psd import sector_spectra, windowed_map
 
 
@@ -83,6 +83,7 @@ def rose(surface, step=10.0, width=None, band=None, resolution=None, order=1, sa
     from scipy import fft
 
     field, power = windowed_map(surface, order)
+    refuse_flat(field, surface.heights)
     transform = fft.rfft2(field, workers=-1)
     count = round(180 / step)
     sectors = sector_spectra(field, power, surface.spacing, low, high, frequency_step,

@@ -27,7 +27,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 
 from ..errors import InputError
-from ..surface import Surface, Units
+from ..surface import Surface, Units, check_size
 from . import model
 
 log = logging.getLogger("rough")
@@ -44,6 +44,7 @@ def synthesize_profile(points, spacing, dimension, amplitude=None, rq=None, reso
     surface is self-affine only below that scale."""
     beta = model.profile_exponent(dimension)
     resolution = _amplitude_choice(amplitude, rq, resolution, spacing)
+    check_size((points,), "the profile")
     seed = _seed(seed)
     generator = np.random.Generator(np.random.PCG64(np.random.SeedSequence(seed)))
     spectrum = _white_profile_spectrum(points, generator)
@@ -74,6 +75,7 @@ def synthesize_map(points, spacing, dimension, amplitude=None, rq=None, resoluti
             raise InputError("give the anisotropy's C values or --rq, not both")
     model.check_dimension(dimension, profile=False)
     resolution = _amplitude_choice(amplitude, rq, resolution, min(spacing))
+    check_size((ny, nx), "the map")
     seed = _seed(seed)
     spectrum = _white_map_spectrum(nx, ny, seed)
     pairs = spectrum.view(np.float32).reshape(ny, nx // 2 + 1, 2)
@@ -97,6 +99,7 @@ def synthesize_fragments(points, spacing, dimension, amplitude=None, rq=None, re
     one ended. ``as_printed`` also applies the printed (k+1) index shift."""
     beta = model.profile_exponent(dimension)
     resolution = _amplitude_choice(amplitude, rq, resolution, spacing)
+    check_size((points,), "the profile")
     seed = _seed(seed)
     generator = np.random.Generator(np.random.PCG64(np.random.SeedSequence(seed)))
     scale = model.prefactor(amplitude or 1.0, dimension, resolution)

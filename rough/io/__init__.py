@@ -19,6 +19,7 @@ import logging
 import os
 import struct
 import sys
+import tokenize
 import xml.etree.ElementTree
 import zipfile
 import zlib
@@ -52,12 +53,14 @@ _MAGIC = (
 )
 GZIP_MAGIC = b"\x1f\x8b"
 log = logging.getLogger("rough")
-MAX_UNPACKED_BYTES = 1 << 32
+MAX_UNPACKED_BYTES = 1 << 30
+BOMB_RATIO, BOMB_FLOOR = 1000, 64 << 20  # past 64 MB unpacked, a ratio over 1000:1 is a gzip bomb
 
 # What a malformed file makes the parsers raise; read() turns these into FormatError.
 _PARSE_ERRORS = (
     ValueError, TypeError, KeyError, IndexError, struct.error, zipfile.BadZipFile,
-    xml.etree.ElementTree.ParseError, UnicodeError, EOFError, OverflowError, zlib.error,
+    xml.etree.ElementTree.ParseError, UnicodeError, EOFError, OverflowError, zlib.error, SyntaxError,
+    tokenize.TokenError,
 )
 
 
@@ -88,28 +91,39 @@ def read(source, *, spacing=None, unit=None, verify=True):
         surface = read_bytes(data, options)
     except InputError as error:
         raise type(error)(f"{name}: {error}") from error
-    except MemoryError:
-        raise InputError(f"{name}: too large to read into memory") from None
-    except _PARSE_ERRORS as error:
-        raise FormatError(f"{name}: malformed {describe(sniff(data))} file ({error})") from error
     surface.metadata.setdefault("source", name)
     return surface
 
 
 def read_bytes(data, options=ReadOptions()):
-    """Parse a whole file's bytes (sniffing the format) into a Surface."""
+    """Parse a whole file's bytes (sniffing the format) into a Surface. Raises
+    InputError (FormatError for malformed data) and nothing else for bad input."""
+    try:
+        return _parse(data, options)
+    except MemoryError:
+        raise InputError("too large to read into memory") from None
+    except _PARSE_ERRORS as error:
+        raise FormatError(f"malformed {describe(sniff(data))} file ({error})") from error
+
+
+def _parse(data, options):
     if not data:
         raise FormatError("empty file, no surface to read")
     if bytes(data[:2]) == GZIP_MAGIC:
-        return read_bytes(gunzip(data), options)
+        return _parse(gunzip(data), options)
     format_name = sniff(data)
-    surface = _module(format_name).read(data, options)
+    with np.errstate(all="ignore"):
+        surface = _module(format_name).read(data, options)
     surface.source_format = format_name
-    if not np.isfinite(np.sum(surface.heights)):
+    if not np.isfinite(surface.heights).all():
         infinite = np.isinf(surface.heights)
         if infinite.any():
             log.info("%d infinite heights marked invalid (NaN)", infinite.sum())
             surface.heights = np.where(infinite, np.nan, surface.heights)
+    if surface.heights.size < 2:
+        raise FormatError(f"holds {surface.heights.size} point; a surface needs at least two points")
+    if np.isnan(surface.heights).all():
+        raise FormatError(f"holds no valid points (all {surface.heights.size} heights are invalid)")
     if options.spacing is not None and surface.spacing != options.spacing:
         surface = dataclasses.replace(surface, spacing=options.spacing[: surface.heights.ndim])
     return surface
@@ -158,14 +172,21 @@ def format_for_path(path):
 
 
 def gunzip(data, limit=MAX_UNPACKED_BYTES):
-    """Unpack gzip data, refusing to produce more than ``limit`` bytes."""
+    """Unpack gzip data in chunks, refusing more than ``limit`` bytes, or a ratio of
+    unpacked to packed bytes beyond BOMB_RATIO once past BOMB_FLOOR (a gzip bomb)."""
     unpacker = zlib.decompressobj(wbits=31)
-    unpacked = unpacker.decompress(data, limit + 1)
-    if len(unpacked) > limit:
-        raise FormatError(f"gzip data unpack to more than {limit} bytes; refusing")
+    parts, total, pending = [], 0, bytes(data)
+    while pending and not unpacker.eof:
+        part = unpacker.decompress(pending, 16 << 20)
+        pending = unpacker.unconsumed_tail
+        parts.append(part)
+        total += len(part)
+        consumed = len(data) - len(pending) - len(unpacker.unused_data)
+        if total > limit or (total > BOMB_FLOOR and total > BOMB_RATIO * max(consumed, 1)):
+            raise FormatError(f"gzip data unpack to more than {total >> 20} MB from {consumed} bytes; refusing (a gzip bomb?)")
     if not unpacker.eof:
         raise FormatError("truncated gzip data")
-    return unpacked
+    return b"".join(parts)
 
 
 def _module(format_name):

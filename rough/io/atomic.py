@@ -31,7 +31,9 @@ def atomic_output(path):
         with os.fdopen(fd, "wb") as stream:
             yield stream
         os.replace(temporary, path)
-    except BaseException:
+    except BaseException as error:
         with contextlib.suppress(OSError):
             os.unlink(temporary)
+        if isinstance(error, OSError) and not isinstance(error, BrokenPipeError) and error.filename is None:
+            raise OSError(error.errno, error.strerror, path) from error  # name the file, not a temporary
         raise

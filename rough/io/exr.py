@@ -15,7 +15,10 @@ spacing must come from ``--spacing``. Heights are float32, so a round trip keeps
 them to float32 rounding.
 """
 
+import contextlib
 import io
+import os
+import sys
 
 import numpy as np
 
@@ -37,17 +40,21 @@ def read(data, options):
     nx, ny = int(high[0] - low[0] + 1), int(high[1] - low[1] + 1)
     if nx < 1 or ny < 1 or nx * ny > MAX_POINTS or nx * ny * 2 > MAX_EXPANSION * len(data):
         raise FormatError(f"EXR data window of {nx}×{ny} pixels is impossible for a file of {len(data)} bytes")
-    channels = _open(OpenEXR, data).channels()
+    with _library_quiet():
+        channels = _open(OpenEXR, data).channels()
     name = next((c for c in HEIGHT_CHANNELS if c in channels), None)
     if name is None and len(channels) == 1:
         name = next(iter(channels))
     if name is None:
         raise FormatError(f"EXR has channels {', '.join(sorted(channels))}; rough reads one height channel (Y, Z or R)")
-    heights = np.asarray(channels[name].pixels, dtype=np.float64)
+    with _library_quiet():  # the bindings read the pixels on first access
+        pixels = channels[name].pixels
+    heights = np.asarray(pixels, dtype=np.float64)
     if heights.shape != (ny, nx):
         raise FormatError(f"EXR channel {name} has shape {heights.shape}, expected {(ny, nx)}")
-    xy_factor = metres_per(header.get("Gwy::XYUnit") or "m")
-    heights = _scale_values(heights, header) * metres_per(header.get("Gwy::ZUnit") or "m")
+    xy_unit, z_unit, title = (_string(header, key) for key in ("Gwy::XYUnit", "Gwy::ZUnit", "Gwy::Title"))
+    xy_factor = metres_per(xy_unit or "m")
+    heights = _scale_values(heights, header) * metres_per(z_unit or "m")
     if "Gwy::XReal" in header and "Gwy::YReal" in header:
         spacing = (_double(header, "Gwy::XReal") * xy_factor / nx, _double(header, "Gwy::YReal") * xy_factor / ny)
     elif options.spacing is not None:
@@ -55,8 +62,8 @@ def read(data, options):
     else:
         raise FormatError("EXR file has no Gwy::XReal and Gwy::YReal attributes, so no spacing; give it with --spacing")
     origin = (_double(header, "Gwy::XOffset", 0.0) * xy_factor, _double(header, "Gwy::YOffset", 0.0) * xy_factor)
-    metadata = {"title": header["Gwy::Title"]} if header.get("Gwy::Title") else {}
-    units = Units(header.get("Gwy::XYUnit", "m"), header.get("Gwy::ZUnit", "m"))
+    metadata = {"title": title} if title else {}
+    units = Units(xy_unit or "m", z_unit or "m")
     metadata, units, history = provenance.restore(
         {part: header.get(f"rough:{part}") for part in provenance.PARTS}, metadata, units
     )
@@ -92,9 +99,35 @@ def write(surface, stream):
 
 def _open(OpenEXR, data, header_only=False):
     try:
-        return OpenEXR.File(io.BytesIO(bytes(data)), separate_channels=True, header_only=header_only)
+        with _library_quiet():
+            return OpenEXR.File(io.BytesIO(bytes(data)), separate_channels=True, header_only=header_only)
     except Exception as error:  # noqa: BLE001 -- the bindings raise plain RuntimeError/Exception for bad files
         raise FormatError(f"not a readable OpenEXR file ({error})") from None
+
+
+@contextlib.contextmanager
+def _library_quiet():
+    """Keep the OpenEXR library's own messages about a bad file (the C core writes to
+    standard error, the Python bindings to standard output, flushed at once) off both:
+    rough reports the failure itself, in one line, and standard output may be a pipe
+    that carries data."""
+    try:
+        saved = [os.dup(1), os.dup(2)]
+    except OSError:
+        yield
+        return
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    try:
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os.dup2(devnull, 1)
+        os.dup2(devnull, 2)
+        yield
+    finally:
+        for descriptor, copy in enumerate(saved, start=1):
+            os.dup2(copy, descriptor)
+            os.close(copy)
+        os.close(devnull)
 
 
 def _scale_values(values, header):
@@ -104,6 +137,14 @@ def _scale_values(values, header):
         low = _double(header, "Gwy::ZMin", 0.0)
         return low + values * (_double(header, "Gwy::ZMax") - low) / (2.0**32 - 1 + 0.999)
     return values * _double(header, "Gwy::ZScale", 1.0)
+
+
+def _string(header, key):
+    """A text attribute, or None when absent; anything else there is damage."""
+    value = header.get(key)
+    if value is not None and not isinstance(value, str):
+        raise FormatError(f"EXR attribute {key} should be text, not {type(value).__name__}")
+    return value
 
 
 def _double(header, key, default=None):

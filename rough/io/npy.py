@@ -13,17 +13,30 @@ from ..surface import Surface
 
 
 def read(data, options):
+    """The header is checked (numbers, 1-D or 2-D, as many bytes as it declares) before
+    any array is made; object arrays are never unpickled."""
+    stream = io.BytesIO(bytes(data))
     try:
-        heights = np.load(io.BytesIO(bytes(data)), allow_pickle=False)
+        version = np.lib.format.read_magic(stream)
+        reader = {(1, 0): np.lib.format.read_array_header_1_0, (2, 0): np.lib.format.read_array_header_2_0}.get(version)
+        if reader is None:
+            raise FormatError(f"NPY format version {version[0]}.{version[1]} is not supported")
+        shape, fortran, dtype = reader(stream)
     except ValueError as error:
         raise FormatError(f"not a readable NPY array ({error})") from None
-    if not (np.issubdtype(heights.dtype, np.floating) or np.issubdtype(heights.dtype, np.integer)):
-        raise FormatError(f"NPY array holds {heights.dtype}, not numbers")
-    if heights.ndim not in (1, 2):
-        raise FormatError(f"NPY array is {heights.ndim}-D; a surface is 1-D (profile) or 2-D (map)")
+    if not (np.issubdtype(dtype, np.floating) or np.issubdtype(dtype, np.integer)):
+        raise FormatError(f"NPY array holds {dtype}, not numbers")
+    if len(shape) not in (1, 2):
+        raise FormatError(f"NPY array is {len(shape)}-D; a surface is 1-D (profile) or 2-D (map)")
+    count = int(np.prod(shape, dtype=object))
+    available = len(data) - stream.tell()
+    if count * dtype.itemsize > available:
+        raise FormatError(f"NPY header declares {'×'.join(map(str, shape))} values of {dtype.itemsize} bytes; the file holds {available} bytes")
     if options.spacing is None:
         raise FormatError("NPY files carry no spacing; give it with --spacing (e.g. --spacing 1um)")
-    return Surface(heights, options.spacing[: heights.ndim])
+    heights = np.frombuffer(data, dtype, count=count, offset=stream.tell())
+    heights = heights.reshape(shape[::-1]).T if fortran else heights.reshape(shape)
+    return Surface(heights.astype(np.float64), options.spacing[: len(shape)])
 
 
 def write(surface, stream):

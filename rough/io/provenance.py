@@ -4,6 +4,7 @@ carries it (X3P: a vendor member; EXR: header attributes; GSF: extra keys; text:
 
 import json
 
+from ..errors import FormatError
 from ..surface import Units
 
 PARTS = ("units", "metadata", "history")
@@ -24,6 +25,9 @@ def restore(stored, metadata=None, units=None):
     parsed objects; any part may be missing), on top of what the file's own header
     said."""
     given = {part: json.loads(value) if isinstance(value, str) else value for part, value in stored.items() if value}
+    for part, kind in (("units", dict), ("metadata", dict), ("history", list)):
+        if part in given and not isinstance(given[part], kind):
+            raise FormatError(f"rough's {part} record in the file is damaged")
     metadata = {**(metadata or {}), **{str(k): str(v) for k, v in given.get("metadata", {}).items()}}
     if "units" in given:
         units = Units(**{k: str(v) for k, v in given["units"].items() if k in ("xy", "z")})

@@ -250,6 +250,8 @@ def _split(line, delimiter):
 def _numbers(body, delimiter, columns):
     """The numeric table of the data lines, rows × columns, NaN for ``BAD``/``nan``.
     ``columns`` defaults to as many as the first line has (trailing separators aside)."""
+    if not any(line.strip() for line in body):
+        raise FormatError("no numeric data found")
     block = "\n".join(body)
     if delimiter in (";", "\t") and any("," in line for line in body[:10]):
         block = block.replace(",", ".")

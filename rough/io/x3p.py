@@ -24,6 +24,7 @@ import hashlib
 import io
 import json
 import logging
+import lzma
 import re
 import struct
 import weakref
@@ -43,6 +44,9 @@ NAMESPACE = "http://www.opengps.eu/2008/ISO5436_2"
 VENDOR_ID = "urn:x-rough:x3p-vendor:1"
 VENDOR_MEMBER = "vendor/rough.json"
 DATA_TYPES = {"I": "<i2", "L": "<i4", "F": "<f4", "D": "<f8"}
+# What zipfile raises for damaged or unusual archives (bz2 raises OSError, lzma LZMAError)
+ZIP_ERRORS = (zipfile.BadZipFile, zipfile.LargeZipFile, NotImplementedError, RuntimeError, OSError, EOFError, zlib.error,
+              lzma.LZMAError)
 MAX_POINTS = 1 << 31
 MAX_XML_BYTES = 1 << 31
 MAX_SIDE_BYTES = 1 << 26
@@ -54,7 +58,7 @@ log = logging.getLogger("rough")
 def read(data, options):
     try:
         archive = zipfile.ZipFile(io.BytesIO(data))
-    except zipfile.BadZipFile as error:
+    except (*ZIP_ERRORS, ValueError) as error:
         raise FormatError(f"not a valid X3P zip archive ({error})") from None
     prefix, main_name = _find_main(archive)
     document = _member(archive, main_name, data, limit=MAX_XML_BYTES)
@@ -74,9 +78,6 @@ def read(data, options):
         raise FormatError(f"MatrixDimension declares {nx}×{ny}×{layers} points, more than rough handles")
     if feature == "PRF" and ny != 1:
         raise FormatError(f"an X3P profile (PRF) must have SizeY 1, not {ny}")
-    if layers > 1:
-        log.warning("X3P file holds %d layers; reading the first", layers)
-
     absolute = [name for name in ("CX", "CY") if axes[name]["type"] == "A"]
     fields = [(name, axes[name]["dtype"]) for name in (*absolute, "CZ")]
     count = nx * ny * layers
@@ -105,7 +106,10 @@ def read(data, options):
         metadata, units, history = _vendor(archive, prefix, data)
     else:
         metadata, units, history = _metadata(root), Units("m", "m"), []
-    return Surface(heights, tuple(spacing), tuple(origin), units, metadata, history)
+    surface = Surface(heights, tuple(spacing), tuple(origin), units, metadata, history)
+    if layers > 1:
+        log.warning("X3P file holds %d layers; reading the first", layers)
+    return surface
 
 
 def write(surface, stream):
@@ -162,14 +166,21 @@ def _member(archive, name, data, limit=None, expected=None, check_crc=True):
         if check_crc and zlib.crc32(content) != info.CRC:
             raise FormatError(f"{name} fails its zip CRC check: the archive is damaged")
         return content
-    with archive.open(info) as member:
-        content = member.read(info.file_size + 1)
+    if info.flag_bits & 0x1:
+        raise FormatError(f"{name} is encrypted; X3P members are plain")
+    try:
+        with archive.open(info) as member:
+            content = member.read(info.file_size + 1)
+    except ZIP_ERRORS as error:
+        raise FormatError(f"{name} cannot be unpacked ({type(error).__name__}: {error})") from None
     if len(content) != info.file_size:
         raise FormatError(f"{name} does not hold the {info.file_size} bytes its zip entry declares")
     return content
 
 
 def _parse_xml(document):
+    if document.startswith((b"\xff\xfe", b"\xfe\xff")) or b"\x00" in document[:64]:
+        raise FormatError("main.xml is not UTF-8, as X3P requires")
     if b"<!DOCTYPE" in document or b"<!ENTITY" in document:
         raise FormatError("main.xml declares a DOCTYPE or entities, which X3P does not use; refusing to parse it")
     document = document.removeprefix(b"\xef\xbb\xbf")

@@ -6,6 +6,9 @@ the source slides' feature detection and the scale dependence of Rq.
     >>> parameters(roughness)["Ra"]
 """
 
+import logging
+import math
+
 import numpy as np
 
 from ..errors import InputError
@@ -16,6 +19,7 @@ from .parameters import AREAL, PROFILE, amplitude_density, areal_parameters, pro
 from .scale import rq_versus_length
 
 KEEP = ("roughness", "waviness", "form")
+log = logging.getLogger("rough")
 
 __all__ = [
     "AREAL", "KEEP", "PROFILE", "Feature", "amplitude_density", "areal_parameters", "detect_features", "detrend",
@@ -56,10 +60,37 @@ def parameters(surface, cutoff=None, ends="trim", sampling_lengths=5, slope="2po
     """
     evaluated = surface if cutoff is None else split(surface, cutoff, "roughness", ends)
     if surface.is_profile:
-        return profile_parameters(evaluated, sampling_lengths, slope, jrc_spacing)
-    if along is None:
-        return areal_parameters(evaluated, slope)
-    return _profiles_of_map(evaluated, along, sampling_lengths, slope, jrc_spacing)
+        values = profile_parameters(evaluated, sampling_lengths, slope, jrc_spacing)
+    elif along is None:
+        values = areal_parameters(evaluated, slope)
+    else:
+        values = _profiles_of_map(evaluated, along, sampling_lengths, slope, jrc_spacing)
+    _announce_undefined(values)
+    return values
+
+
+UNDEFINED = {
+    "no height variation": ("Rsk", "Rku", "Ssk", "Sku", "Sal", "Str", "Std"),
+    "no profile element rises and falls 10 % of Rz across the mean line": ("RSm",),
+    "the profile spans fewer than three JRC spacings": ("Z2",),
+    "Z2 is zero or undefined": ("JRC",),
+    "no two neighbouring points are valid": ("Rdq", "Sdq", "Sdr"),
+}
+
+
+def _announce_undefined(values):
+    """One warning naming each parameter that came out undefined (NaN) and why (Str has
+    its own warning when Sal is defined)."""
+    undefined = {key for key, value in values.items() if math.isnan(value)}
+    if "Str" in undefined and "Sal" not in undefined:
+        undefined.discard("Str")
+    reasons = []
+    for reason, keys in UNDEFINED.items():
+        named = [key for key in keys if key in undefined]
+        if named:
+            reasons.append(f"{', '.join(named)} ({reason})")
+    if reasons:
+        log.warning(f"undefined for this surface: {'; '.join(reasons)}")
 
 
 def _profiles_of_map(surface, along, sampling_lengths, slope, jrc_spacing):

@@ -36,6 +36,7 @@ log = logging.getLogger("rough")
 
 SLOPES = ("2point", "7point")
 SEVEN_POINT = np.array([1.0, -9.0, 45.0, 0.0, -45.0, 9.0, -1.0]) / 60.0
+ROUNDING = 1e-12  # relative: deviations from the mean this small are the mean's own rounding
 
 # key: (unit, what it is). Units: "m", "1/m", "1" (dimensionless), "%", "deg".
 PROFILE = {
@@ -69,18 +70,31 @@ AREAL = {
 }
 
 
+def centred(heights):
+    """``heights`` less the mean of their valid points (NaN stays NaN); exactly zero
+    where they differ from that mean only by its rounding (a constant surface)."""
+    valid = heights[~np.isnan(heights)]
+    if not valid.size:
+        return heights
+    mean = valid.mean()
+    deviation = heights - mean
+    if np.nanmax(np.abs(deviation)) <= ROUNDING * abs(mean):
+        return np.where(np.isnan(heights), np.nan, 0.0)
+    return deviation
+
+
 def amplitude(values):
-    """Mean-removed moments of a 1-D array of valid heights: Ra, Rq, Rsk, Rku, and
-    the height range (max, min) about the mean."""
+    """Mean-removed moments of a 1-D array of valid heights: Ra, Rq, Rsk, Rku (NaN for a
+    constant surface), and the height range (max, min) about the mean."""
     if values.size == 0:
         raise InputError("no valid points: nothing to evaluate")
-    centred = values - values.mean()
-    squared = centred * centred
+    centred_values = centred(values)
+    squared = centred_values * centred_values
     rq = math.sqrt(squared.mean())
-    skew = float(np.mean(squared * centred)) / rq**3 if rq > 0 else math.nan
+    skew = float(np.mean(squared * centred_values)) / rq**3 if rq > 0 else math.nan
     kurtosis = float(np.mean(squared * squared)) / rq**4 if rq > 0 else math.nan
-    return {"a": float(np.abs(centred).mean()), "q": rq, "sk": skew, "ku": kurtosis,
-            "p": float(centred.max()), "v": float(-centred.min())}
+    return {"a": float(np.abs(centred_values).mean()), "q": rq, "sk": skew, "ku": kurtosis,
+            "p": float(centred_values.max()), "v": 0.0 - float(centred_values.min())}
 
 
 def slopes(heights, spacing, method="2point", axis=-1):
@@ -104,9 +118,9 @@ def profile_parameters(surface, sampling_lengths=5, slope="2point", jrc_spacing=
     z = surface.heights
     dx = surface.spacing[0]
     valid = ~np.isnan(z)
-    centred = z - np.nanmean(z) if valid.any() else z
+    levels = centred(z)
     moments = amplitude(z[valid])
-    rp, rv = _per_sampling_length(centred, sampling_lengths)
+    rp, rv = _per_sampling_length(levels, sampling_lengths)
     rz = rp + rv
     length = z.size * dx
     slope_values = slopes(z, dx, slope)
@@ -114,9 +128,9 @@ def profile_parameters(surface, sampling_lengths=5, slope="2point", jrc_spacing=
     return {
         "Ra": moments["a"], "Rq": moments["q"], "Rsk": moments["sk"], "Rku": moments["ku"],
         "Rp": rp, "Rv": rv, "Rz": rz, "Rt": moments["p"] + moments["v"],
-        "RSm": mean_element_width(centred, dx, rz, length / sampling_lengths),
+        "RSm": mean_element_width(levels, dx, rz, length / sampling_lengths),
         "Rdq": _rms(slope_values),
-        "peak_density": peak_count(centred, peak_band * rz) / length,
+        "peak_density": peak_count(levels, peak_band * rz) / length,
         "Z2": z2,
         "JRC": 32.2 + 32.47 * math.log10(z2) if z2 > 0 else math.nan,
     }
@@ -228,10 +242,9 @@ def autocorrelation(surface):
 
     z = surface.heights
     valid = ~np.isnan(z)
-    centred = np.where(valid, z - z[valid].mean(), 0.0)
     ny, nx = z.shape
     shape = (fft.next_fast_len(ny + ny // 2 + 1, real=True), fft.next_fast_len(nx + nx // 2 + 1, real=True))
-    spectrum = fft.rfft2(centred, shape, workers=-1)
+    spectrum = fft.rfft2(np.where(valid, centred(z), 0.0), shape, workers=-1)
     products = fft.irfft2(spectrum * spectrum.conj(), shape, workers=-1)
     del spectrum
     if valid.all():
@@ -244,7 +257,7 @@ def autocorrelation(surface):
     columns = np.r_[shape[1] - hx: shape[1], 0: hx + 1]
     with np.errstate(invalid="ignore", divide="ignore"):
         acf = products[np.ix_(rows, columns)] / pairs[np.ix_(rows, columns)]
-    acf = acf / acf[hy, hx]
+        acf = acf / acf[hy, hx]
     return acf, np.arange(-hx, hx + 1) * surface.spacing[0], np.arange(-hy, hy + 1) * surface.spacing[1]
 
 
@@ -259,7 +272,8 @@ def autocorrelation_lengths(surface, threshold=0.2, directions=360):
     """Sal (the shortest lag at which the ACF falls to ``threshold``) and Str (Sal over
     the longest such decay length among all directions). Lags reach half the map
     along each axis; Str is NaN when the ACF does not fall to ``threshold`` within
-    that in some direction (the texture is longer than half the map)."""
+    that in some direction (the texture is longer than half the map); both are NaN
+    for a constant surface."""
     from scipy.ndimage import map_coordinates
 
     acf, lag_x, lag_y = autocorrelation(surface)
@@ -294,7 +308,7 @@ def angular_spectrum(surface, directions=360):
     z = surface.heights
     valid = ~np.isnan(z)
     window = np.outer(np.hanning(z.shape[0]), np.hanning(z.shape[1]))
-    transform = fft.rfft2(np.where(valid, z - z[valid].mean(), 0.0) * window, workers=-1)
+    transform = fft.rfft2(np.where(valid, centred(z), 0.0) * window, workers=-1)
     power = fft.fftshift(transform.real**2 + transform.imag**2, axes=0)
     ny, nx = z.shape
     dfx, dfy = 1 / (nx * surface.spacing[0]), 1 / (ny * surface.spacing[1])
@@ -313,6 +327,9 @@ def angular_spectrum(surface, directions=360):
 
 def texture_direction(surface):
     """Std: the lay direction, perpendicular to the wavevector of the largest
-    angular power, in degrees counter-clockwise from +x, in [0, 180)."""
+    angular power, in degrees counter-clockwise from +x, in [0, 180); NaN for a
+    constant surface."""
     angles, spectrum = angular_spectrum(surface)
+    if not spectrum.max() > 0:
+        return math.nan
     return float((angles[np.argmax(spectrum)] + 90.0) % 180.0)

@@ -34,15 +34,18 @@ from ..errors import InputError
 log = logging.getLogger("rough")
 
 PRESETS = {"needle": 0.05e-3, "fingernail": 0.5e-3, "fingertip": 8e-3}
-SECONDS_PER_COMPARISON = {1: 5e-10, 2: 4e-10}  # measured on the 2-core build machine, for the warning only
+SECONDS_PER_COMPARISON = {1: 5e-10, 2: 4e-10}  # measured on the 2-core build machine, for the estimate only
+MAX_SECONDS = 3600
 
 
-def tip_profile(radius, spacing):
+def tip_profile(radius, spacing, shape=None):
     """``√(r² - |o|²)`` on the grid of offsets within the radius (1-D or 2-D, metres),
-    -inf outside the disk. ``spacing`` is (dx,) or (dx, dy)."""
+    -inf outside the disk. ``spacing`` is (dx,) or (dx, dy). With the data's ``shape``
+    ((n,) or (ny, nx)) offsets that reach past every sample are left out: they never
+    touch the surface, and a tip far wider than the scan stays small."""
     if not radius > 0:
         raise InputError(f"the tip radius must be positive, not {radius} m")
-    axes = [np.arange(-math.floor(radius / d), math.floor(radius / d) + 1) * d for d in spacing]
+    axes = [np.arange(-reach, reach + 1) * d for reach, d in zip(_reach(radius, spacing, shape), spacing)]
     squared = axes[0] ** 2 if len(axes) == 1 else axes[1][:, None] ** 2 + axes[0][None, :] ** 2
     inside = squared <= radius * radius * (1 + 1e-12)  # offsets on the rim count, whatever the rounding
     return np.where(inside, np.sqrt(np.maximum(radius * radius - squared, 0.0)), -np.inf)
@@ -62,16 +65,24 @@ def closing_envelope(surface, radius):
     return surface.derive("envelope", {"radius": radius}, heights=np.where(np.isnan(surface.heights), np.nan, heights))
 
 
-def _lowering(radius, spacing):
+def _reach(radius, spacing, shape):
+    """Half-width of the tip in samples along x (and y), at most one less than the data's length."""
+    reach = [math.floor(radius / d) for d in spacing]
+    if shape is not None:
+        reach = [min(r, n - 1) for r, n in zip(reach, reversed(shape))]
+    return reach
+
+
+def _lowering(radius, spacing, shape):
     """``-s(o)``: 0 at the apex, -inf outside the tip."""
-    kernel = tip_profile(radius, spacing)
+    kernel = tip_profile(radius, spacing, shape)
     return kernel - kernel[tuple(n // 2 for n in kernel.shape)]
 
 
 def _dilate(heights, radius, spacing):
     """max_o [z(p + o) - s(o)] with NaN ignored; NaN where the input is NaN."""
-    _warn_if_slow(heights, radius, spacing)
-    lowering = _lowering(radius, spacing)
+    _check_cost(heights, radius, spacing)
+    lowering = _lowering(radius, spacing, heights.shape)
     invalid = np.isnan(heights)
     surface = np.where(invalid, -np.inf, heights)
     if heights.ndim == 1:
@@ -85,7 +96,7 @@ def _dilate(heights, radius, spacing):
 
 def _erode(path, radius, spacing):
     """min_o [T(p + o) + s(o)] over the finite points of the traced path ``T``."""
-    lowering = _lowering(radius, spacing)
+    lowering = _lowering(radius, spacing, path.shape)
     known = np.where(np.isnan(path), np.inf, path)
     if path.ndim == 1:
         from scipy import ndimage
@@ -116,9 +127,17 @@ def _rolling_ball(image, lowering):
         return np.vstack(list(pool.map(band, edges[:-1], edges[1:])))
 
 
-def _warn_if_slow(heights, radius, spacing):
-    kernel_points = np.count_nonzero(np.isfinite(tip_profile(radius, spacing)))
+def _check_cost(heights, radius, spacing):
+    """Warn when a pass takes more than ten seconds; refuse past an hour."""
+    reach = _reach(radius, spacing, heights.shape)
+    box = math.prod(2 * r + 1 for r in reach)
+    disk = math.pi * math.prod(radius / d for d in spacing) if heights.ndim == 2 else box
+    kernel_points = min(box, disk)
     seconds = heights.size * kernel_points * SECONDS_PER_COMPARISON[heights.ndim]
+    size = f"a {radius * 1e3:g} mm tip spans about {kernel_points:.0f} samples of this surface"
+    if seconds > MAX_SECONDS:
+        raise InputError(f"{size}: one pass would take about {seconds / 3600:.0f} h; "
+                         "resample the surface to a coarser spacing first")
     if seconds > 10:
-        log.warning(f"a {radius * 1e3:g} mm tip spans {kernel_points} samples: this takes about {seconds:.0f} s per pass "
+        log.warning(f"{size}: this takes about {seconds:.0f} s per pass "
                     "(resample to a coarser spacing for a quicker answer)")

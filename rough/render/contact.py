@@ -114,9 +114,12 @@ def zero_order_hold(stiffness, damping, mass, period):
 
 
 def clamp(fx, fy, limit):
-    """Scale ``(fx, fy)`` down to magnitude ``limit`` (N) if it is larger, keeping its direction."""
+    """Scale ``(fx, fy)`` down to magnitude ``limit`` (N) if it is larger, keeping its
+    direction; a force that is not finite becomes zero."""
     magnitude = math.hypot(fx, fy)
     if magnitude <= limit:
         return fx, fy
+    if not magnitude < math.inf:  # NaN or infinite: a glitch, never a force to send
+        return 0.0, 0.0
     scale = limit / magnitude
     return fx * scale, fy * scale

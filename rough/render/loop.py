@@ -15,7 +15,9 @@ period or more late counts its deadlines as missed and the schedule skips them r
 than bursting. A simulated device runs as fast as the machine allows unless
 ``realtime`` is set. Safety: whatever ends the loop (its duration, Ctrl-C, an
 exception, a device error), the device is closed, which zeroes the force; a watchdog
-thread zeroes it too if the loop stalls for ``watchdog`` seconds.
+thread zeroes it too if the loop stalls for ``watchdog`` seconds (default 10 ms: long
+enough to ride through an operating-system hiccup, short enough that a hand never
+feels a stuck force). A non-finite force (a glitched position) is written as zero.
 """
 
 import array
@@ -23,6 +25,7 @@ import dataclasses
 import gc
 import math
 import os
+import sys
 import threading
 import time
 
@@ -49,7 +52,7 @@ class Settings:
     max_force: float = MAX_FORCE
     realtime: bool = True
     velocity_cutoff: float = 100.0
-    watchdog: float = 0.05
+    watchdog: float = 0.01
     priority: int = 50
 
     @property
@@ -98,7 +101,8 @@ class Run:
 
 
 class _Watchdog(threading.Thread):
-    """Zeroes the device's force if the loop's tick count stops advancing."""
+    """Zeroes the device's force if the loop's tick count stops advancing for
+    ``timeout`` seconds (looking eight times per timeout)."""
 
     def __init__(self, device, timeout):
         super().__init__(name="rough-render-watchdog", daemon=True)
@@ -107,13 +111,14 @@ class _Watchdog(threading.Thread):
         self._done = threading.Event()
 
     def run(self):
-        last = -1
-        while not self._done.wait(self.timeout):
-            if self.tick == last:
+        last, changed = -1, time.monotonic()
+        while not self._done.wait(self.timeout / 8):
+            if self.tick != last:
+                last, changed = self.tick, time.monotonic()
+            elif time.monotonic() - changed > self.timeout:
                 self.tripped = True
                 self.device.emergency_stop()
                 return
-            last = self.tick
 
     def stop(self):
         self._done.set()
@@ -131,12 +136,16 @@ def run(device, tracks, model, friction=None, settings=None, until=None):
     collector = gc.isenabled()
     gc.disable()
     previous, scheduling = _raise_priority(settings.priority) if settings.realtime else (None, "unpaced")
+    switching = sys.getswitchinterval()
+    if watchdog is not None:  # a loop stuck in Python code must hand the watchdog the interpreter soon
+        sys.setswitchinterval(min(switching, settings.watchdog / 8))
     loop = _Loop(device, tracks, model, friction, settings, watchdog, until)
     try:
         loop.spin()
     except KeyboardInterrupt:
         loop.ended_by = "interrupt"
     finally:
+        sys.setswitchinterval(switching)
         if previous is not None:
             os.sched_setscheduler(0, *previous)
         if watchdog is not None:
