@@ -147,3 +147,13 @@ def test_parameters_scale_with_the_units(scale):
         assert other[key] == pytest.approx(one[key] * scale / 1e-6, rel=1e-9)
     for key in ("Ssk", "Sku", "Sdq", "Str", "Std"):
         assert other[key] == pytest.approx(one[key], rel=1e-9, abs=1e-9)
+
+
+def test_only_the_rounding_of_the_mean_counts_as_flat():
+    """A kilometre offset with sub-nanometre roughness is rough; a constant is flat."""
+    from rough.metrology import parameters
+
+    noise = np.random.default_rng(1).normal(size=4096) * 1e-10
+    assert parameters(Surface(1e3 + noise, (1e-6,)))["Rq"] == pytest.approx(1e-10, rel=0.05)
+    flat = parameters(Surface(np.full(4096, 1e3 + 1e-10), (1e-6,)))
+    assert flat["Rq"] == 0.0 and math.isnan(flat["Rsk"])

@@ -44,7 +44,9 @@ def surfaces(draw):
         "constant": np.full(shape, 0.25),
     }[heights] * scale
     holes = draw(st.sampled_from([0.0, 0.1, 0.5]))
-    values[rng.random(shape) < holes] = np.nan
+    missing = rng.random(shape) < holes
+    missing.flat[rng.integers(missing.size)] = False  # a surface with no valid point is refused on reading
+    values[missing] = np.nan
     ndim = len(shape)
     return Surface(
         values,
@@ -54,6 +56,14 @@ def surfaces(draw):
         draw(metadata),
         draw(history),
     )
+
+
+@pytest.mark.parametrize("fmt", FLOAT64 + FLOAT32)
+def test_a_surface_with_no_valid_point_is_written_but_refused_on_reading(fmt):
+    from rough.errors import InputError
+
+    with pytest.raises(InputError, match="no valid points"):
+        round_trip(Surface(np.full((3, 4), np.nan), (1e-6, 1e-6)), fmt)
 
 
 def round_trip(surface, fmt, options=None):
