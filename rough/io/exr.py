@@ -35,21 +35,16 @@ MAX_EXPANSION = 1100  # more than zlib's largest compression ratio (about 1032:1
 def read(data, options):
     import OpenEXR
 
-    header = _open(OpenEXR, data, header_only=True).header()
+    with _library_quiet():
+        header = _open(OpenEXR, data, header_only=True).header()
     low, high = header["dataWindow"]
     nx, ny = int(high[0] - low[0] + 1), int(high[1] - low[1] + 1)
     if nx < 1 or ny < 1 or nx * ny > MAX_POINTS or nx * ny * 2 > MAX_EXPANSION * len(data):
         raise FormatError(f"EXR data window of {nx}×{ny} pixels is impossible for a file of {len(data)} bytes")
-    with _library_quiet():
-        channels = _open(OpenEXR, data).channels()
-    name = next((c for c in HEIGHT_CHANNELS if c in channels), None)
-    if name is None and len(channels) == 1:
-        name = next(iter(channels))
-    if name is None:
-        raise FormatError(f"EXR has channels {', '.join(sorted(channels))}; rough reads one height channel (Y, Z or R)")
     with _library_quiet():  # the bindings read the pixels on first access
-        pixels = channels[name].pixels
-    heights = np.asarray(pixels, dtype=np.float64)
+        channels = _open(OpenEXR, data).channels()
+        name = _height_channel(channels)
+        heights = np.asarray(channels[name].pixels, dtype=np.float64)
     if heights.shape != (ny, nx):
         raise FormatError(f"EXR channel {name} has shape {heights.shape}, expected {(ny, nx)}")
     xy_unit, z_unit, title = (_string(header, key) for key in ("Gwy::XYUnit", "Gwy::ZUnit", "Gwy::Title"))
@@ -99,10 +94,19 @@ def write(surface, stream):
 
 def _open(OpenEXR, data, header_only=False):
     try:
-        with _library_quiet():
-            return OpenEXR.File(io.BytesIO(bytes(data)), separate_channels=True, header_only=header_only)
+        return OpenEXR.File(io.BytesIO(bytes(data)), separate_channels=True, header_only=header_only)
     except Exception as error:  # noqa: BLE001 -- the bindings raise plain RuntimeError/Exception for bad files
         raise FormatError(f"not a readable OpenEXR file ({error})") from None
+
+
+def _height_channel(channels):
+    """Y, Z or R (in that order), or the only channel there is."""
+    name = next((c for c in HEIGHT_CHANNELS if c in channels), None)
+    if name is None and len(channels) == 1:
+        name = next(iter(channels))
+    if name is None:
+        raise FormatError(f"EXR has channels {', '.join(sorted(channels))}; rough reads one height channel (Y, Z or R)")
+    return name
 
 
 @contextlib.contextmanager
