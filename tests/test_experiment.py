@@ -269,8 +269,9 @@ def test_a_joystick_session_toggles_with_the_trigger_and_answers_with_buttons_2_
     other surface once, then presses button 2 (first rougher) or 3 (second rougher)."""
     from virtual_joystick import FakeHandle, PidJoystick
 
+    from rough import read
     from rough.experiment.session import joystick_presenter, run_session
-    from rough.render import QuasiStatic, Settings
+    from rough.render import QuasiStatic, Settings, Track
     from rough.render.hid import Joystick
 
     surfaces, sets = grid_design([(1.3, 0.1e-3)], 0.05, 1.2)
@@ -284,7 +285,8 @@ def test_a_joystick_session_toggles_with_the_trigger_and_answers_with_buttons_2_
         script += [0, 0, 1, 0, 2 if trial % 2 == 0 else 4, 0]
     for k, buttons in enumerate(script):
         handle.schedule(0.04 * k, buttons=buttons)
-    present = joystick_presenter(design, joystick, QuasiStatic(), None, Settings(watchdog=1.0), NoKeys())
+    tracks = {name: Track.from_surface(read(design.surface_path(name))) for name in design.surfaces}
+    present = joystick_presenter(tracks, joystick, QuasiStatic(), None, Settings(watchdog=1.0), NoKeys())
     progress = run_session(design, "P1", present, "virtual joystick")
     joystick.close()
     rows = read_answers(design, "P1")

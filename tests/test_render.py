@@ -474,3 +474,23 @@ def test_a_vanished_joystick_leaves_no_force():
     with pytest.raises(DeviceGone):
         run(stick, [Track(np.full(101, 1e-3), 1e-4)], QuasiStatic(), None, Settings(duration=1.0, watchdog=1.0))
     assert device.force() == (0.0, 0.0) and handle.closed
+
+
+@pytest.mark.parametrize("stick_span, expected", [((0.08,), (1e-2, 4e-3)), ((0.08, 0.02), (0.08, 0.02))])
+def test_the_stick_spans_the_tracks_unless_both_spans_are_given(monkeypatch, stick_span, expected):
+    """render and experiment open the joystick through one function: a single
+    --stick-span value falls back to the tracks' own spans (it used to crash experiment)."""
+    from virtual_joystick import FakeHandle, PidJoystick
+
+    from rough.render import hid
+    from rough.render.session import open_joystick
+
+    device = PidJoystick()
+    handle = FakeHandle(device)
+    handle.move(0.5, 0.5, 0)
+    monkeypatch.setattr(hid, "find_joystick", lambda spec: (handle, device.descriptor, "virtual"))
+    ramp = Track(np.linspace(0, 1e-3, 101), 1e-4)
+    joystick, label = open_joystick("hid", [RAISED, ramp], 8.9, stick_span)
+    assert label == "virtual" and (joystick.x_span, joystick.y_span) == pytest.approx(expected)
+    assert joystick.y_centre == pytest.approx(1e-3)
+    joystick.close()

@@ -132,20 +132,14 @@ def _joystick_session(study, subject, haptics, contact, friction):
     from .. import read
     from ..experiment.session import Keyboard, joystick_presenter, run_session
     from ..render import Track
-    from ..render.hid import Joystick, find_joystick
+    from ..render.session import open_joystick
 
-    tracks = [Track.from_surface(read(study.surface_path(name))) for name in study.surfaces]
-    top = max(t.top for t in tracks)
-    x_span, y_span = haptics.stick_span or (tracks[0].length, 4.0 * max(t.top - t.bottom for t in tracks))
-    handle, descriptor, label = find_joystick(haptics.device)
-    try:
-        joystick = Joystick(handle, descriptor, haptics.max_force, tracks[0].start, x_span, top, y_span, haptics.invert)
-    except BaseException:
-        handle.close()
-        raise
+    tracks = {name: Track.from_surface(read(study.surface_path(name))) for name in study.surfaces}
+    joystick, label = open_joystick(haptics.device, list(tracks.values()), haptics.max_force, haptics.stick_span,
+                                    haptics.invert)
     keyboard = Keyboard()
     try:
-        present = joystick_presenter(study, joystick, contact, friction, haptics.settings(), keyboard)
+        present = joystick_presenter(tracks, joystick, contact, friction, haptics.settings(), keyboard)
         return run_session(study, subject, present, label)
     finally:
         keyboard.close()

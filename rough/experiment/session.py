@@ -126,7 +126,7 @@ def simulated_presenter(study, observer, speed, model, friction, settings, **han
             name = trial[side]
             if name not in tracks:
                 tracks[name] = Track.from_surface(read(study.surface_path(name)))
-            stroke = simulate(tracks[name], speed, model, friction, dataclasses.replace(settings), **hand)
+            stroke = simulate(tracks[name], speed, model, friction, settings, **hand)
             if stroke.ended_by == "interrupt":
                 return None
             seconds += stroke.timing()["simulated_time"]
@@ -195,15 +195,13 @@ class Keyboard:
             self._restore()
 
 
-def joystick_presenter(study, joystick, model, friction, settings, keyboard):
-    """Present a trial on the joystick until the subject answers (the surfaces are read
-    before the first trial, so trials follow each other without a pause)."""
-    from .. import read
-    from ..render import Track
+def joystick_presenter(tracks, joystick, model, friction, settings, keyboard):
+    """Present a trial on the joystick until the subject answers; ``tracks`` maps every
+    surface name of the study to its :class:`~rough.render.Track`, read before the first
+    trial so that trials follow each other without a pause."""
     from ..render.loop import run
 
     held = HeldOpen(joystick)
-    tracks = {name: Track.from_surface(read(study.surface_path(name))) for name in study.surfaces}
 
     def answered(buttons):
         for mask, answer in ANSWER_BUTTONS.items():
@@ -214,7 +212,6 @@ def joystick_presenter(study, joystick, model, friction, settings, keyboard):
     def present(trial):
         pair = [tracks[trial["first"]], tracks[trial["second"]]]
         keyboard.take()
-        model.reset()
         started = time.monotonic()
         result = run(held, pair, model, friction, dataclasses.replace(settings, duration=None), until=answered)
         if result.ended_by != "answer":

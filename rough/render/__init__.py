@@ -43,7 +43,6 @@ def simulate(track, speed, model=None, friction=None, settings=None, press=PRESS
     start = track.at(track.start)[0] - press / model.stiffness
     hand = SimulatedHand(speed, track.start, start, settings.period, press=press, mass=hand_mass,
                          damping=hand_damping, lateral_stiffness=lateral_stiffness)
-    model.reset()
     result = run(hand, [track], model, friction, settings)
     result.speed = speed
     return result

@@ -127,9 +127,13 @@ class _Watchdog(threading.Thread):
 def run(device, tracks, model, friction=None, settings=None, until=None):
     """Run the loop on ``device`` over ``tracks`` (one or two :class:`Track`; the
     trigger switches between two) until ``settings.duration`` passes, ``until(buttons)``
-    returns something true (kept as ``Run.answer``) or Ctrl-C. Returns a :class:`Run`;
-    the device is closed (force zero) however the loop ends."""
+    returns something true (kept as ``Run.answer``) or Ctrl-C. The contact model and
+    friction start afresh. Returns a :class:`Run`; the device is closed (force zero)
+    however the loop ends."""
     settings = settings or Settings()
+    model.reset()
+    if friction is not None:
+        friction.reset()
     watchdog = None
     if settings.realtime and getattr(device, "needs_watchdog", False):
         watchdog = _Watchdog(device, settings.watchdog)

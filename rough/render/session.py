@@ -1,8 +1,6 @@
 """Whole render sessions as the command line runs them: the simulated hand at one or
 more speeds, or a joystick until Ctrl-C; and their summary for people and programs."""
 
-import dataclasses
-
 from ..units import format_unit
 from . import forces, simulate
 from .contact import DynamicStylus, QuasiStatic
@@ -18,18 +16,14 @@ def make_model(name, stiffness, mass, damping, period):
 
 def run_sim(track, speeds, model, friction, settings, **hand):
     """One simulated stroke per speed: ``[(label, Run), ...]`` with labels like ``20mm_s``."""
-    runs = []
-    for speed in speeds:
-        if friction is not None:
-            friction.reset()
-        result = simulate(track, speed, model, friction, dataclasses.replace(settings), **hand)
-        runs.append((f"{speed * 1e3:g}mm_s", result))
-    return runs
+    return [(f"{speed * 1e3:g}mm_s", simulate(track, speed, model, friction, settings, **hand)) for speed in speeds]
 
 
-def run_hid(spec, tracks, model, friction, settings, stick_span=None, invert=()):
-    """A session on the joystick ``spec`` (``hid`` or ``hid:VID:PID``) until the
-    duration passes or Ctrl-C: ``("hid", Run)``."""
+def open_joystick(spec, tracks, max_force, stick_span=None, invert=()):
+    """The joystick ``spec`` (``hid`` or ``hid:VID:PID``) set up for ``tracks``: the
+    stick's x travel spans ``stick_span[0]`` (default the first track's length) and its
+    y travel ``stick_span[1]`` (default four times the largest height range) below the
+    highest top. Returns ``(Joystick, label)``."""
     from .hid import Joystick, find_joystick
 
     handle, descriptor, label = find_joystick(spec)
@@ -38,11 +32,15 @@ def run_hid(spec, tracks, model, friction, settings, stick_span=None, invert=())
     height_range = max(track.top - track.bottom for track in tracks) or 1e-3
     x_span, y_span = stick_span if stick_span and len(stick_span) == 2 else (first.length, 4.0 * height_range)
     try:
-        joystick = Joystick(handle, descriptor, settings.max_force, first.start, x_span, top, y_span, invert)
+        return Joystick(handle, descriptor, max_force, first.start, x_span, top, y_span, invert), label
     except BaseException:
         handle.close()
         raise
-    model.reset()
+
+
+def run_hid(spec, tracks, model, friction, settings, stick_span=None, invert=()):
+    """A session on the joystick ``spec`` until the duration passes or Ctrl-C: ``("hid", Run)``."""
+    joystick, label = open_joystick(spec, tracks, settings.max_force, stick_span, invert)
     result = run(joystick, tracks, model, friction, settings)
     result.device = label
     return "hid", result
