@@ -51,13 +51,13 @@ def detrend(surface, input, order, cutoff, keep, ends, tip, envelope, output):
     if probe is None:
         output.write(remove(surface, order=2 if order is None else order, cutoff=cutoff, keep=keep, ends=ends))
         return
+    if keep == "form":
+        raise InputError("--keep form needs a polynomial, not --tip/--envelope")
+    if keep == "waviness" and cutoff is None:
+        raise InputError("the waviness needs a cut-off (--cutoff)")
     if order is not None:
         surface = remove(surface, order=order)
     surface = traced(surface, probe) if tip is not None else closing_envelope(surface, probe)
-    if keep == "form":
-        raise InputError("--keep form needs a polynomial, not --tip/--envelope")
-    if cutoff is not None or keep == "waviness":
-        if cutoff is None:
-            raise InputError("the waviness needs a cut-off (--cutoff)")
+    if cutoff is not None:
         surface = split(surface, cutoff, keep, ends)
     output.write(surface)

@@ -52,7 +52,8 @@ def features(surface, input, cutoff, ends, sampling_lengths, slope, jrc_spacing,
     from ..io.atomic import atomic_output
 
     evaluated = surface if cutoff is None else metrology.split(surface, cutoff, "roughness", ends)
-    values = metrology.parameters(evaluated, None, ends, sampling_lengths, slope, along, jrc_spacing)
+    values = metrology.parameters(evaluated, sampling_lengths=sampling_lengths, slope=slope, along=along,
+                                  jrc_spacing=jrc_spacing)
     table = metrology.PROFILE if surface.is_profile or along else metrology.AREAL
     rows, document = _parameter_rows(evaluated, values, table, cutoff, sampling_lengths, slope, jrc_spacing, along)
     found = []

@@ -15,7 +15,14 @@ from ..errors import InputError
 from .features import Feature, detect_features
 from .filters import mean_line, split, transmission
 from .form import polynomial_form, remove_form
-from .parameters import AREAL, PROFILE, amplitude_density, areal_parameters, profile_parameters
+from .parameters import (
+    AREAL,
+    PROFILE,
+    amplitude_density,
+    areal_parameters,
+    joint_roughness_coefficient,
+    profile_parameters,
+)
 from .scale import rq_versus_length
 
 KEEP = ("roughness", "waviness", "form")
@@ -41,10 +48,10 @@ def detrend(surface, order=2, cutoff=None, keep="roughness", ends="trim"):
         raise InputError(f"keep must be one of {', '.join(KEEP)}, not {keep!r}")
     if keep == "waviness" and cutoff is None:
         raise InputError("the waviness needs a cut-off (--cutoff)")
-    form = polynomial_form(surface, order)
     if keep == "form":
+        form = polynomial_form(surface, order)
         return surface.derive("detrend", {"order": order, "keep": "form"}, heights=np.where(np.isnan(surface.heights), np.nan, form))
-    levelled = surface.derive("detrend", {"order": order}, heights=surface.heights - form)
+    levelled = remove_form(surface, order)
     return levelled if cutoff is None else split(levelled, cutoff, keep, ends)
 
 
@@ -114,6 +121,5 @@ def _profiles_of_map(surface, along, sampling_lengths, slope, jrc_spacing):
             combined[key] = float(np.sqrt(np.mean(finite**2)))
         else:
             combined[key] = float(np.mean(finite))
-    z2 = combined["Z2"]
-    combined["JRC"] = 32.2 + 32.47 * np.log10(z2) if z2 > 0 else float("nan")
+    combined["JRC"] = joint_roughness_coefficient(combined["Z2"])
     return combined

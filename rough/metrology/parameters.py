@@ -132,7 +132,7 @@ def profile_parameters(surface, sampling_lengths=5, slope="2point", jrc_spacing=
         "Rdq": _rms(slope_values),
         "peak_density": peak_count(levels, peak_band * rz) / length,
         "Z2": z2,
-        "JRC": 32.2 + 32.47 * math.log10(z2) if z2 > 0 else math.nan,
+        "JRC": joint_roughness_coefficient(z2),
     }
 
 
@@ -218,6 +218,11 @@ def peak_count(centred, band):
     side = np.sign(values) * (np.abs(values) > band)
     side = side[side != 0]
     return int(np.count_nonzero((side[:-1] < 0) & (side[1:] > 0)))
+
+
+def joint_roughness_coefficient(z2):
+    """Tse & Cruden's JRC = 32.2 + 32.47 log10(Z2); NaN unless Z2 > 0."""
+    return 32.2 + 32.47 * math.log10(z2) if z2 > 0 else math.nan
 
 
 def _z2(surface, jrc_spacing):
