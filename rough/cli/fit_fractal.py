@@ -41,14 +41,11 @@ def fit_fractal(surface, input, band, resolution, method, order, sampling, fill,
     """
     from ..fractal.fit import fit_fractal as fit
     from ..fractal.psd import binned_spectrum
-    from ..fractal.resample import filled
+    from ..fractal.resample import fill_invalid
     from ..io.atomic import atomic_output
 
-    if fill and surface.heights.size:
-        import numpy as np
-
-        if np.isnan(surface.heights).any():
-            surface = surface.derive("fill", {}, heights=filled(surface))
+    if fill:
+        surface = fill_invalid(surface)
     result = fit(surface, band=band, resolution=resolution, method=method, order=order, sampling=sampling)
     spectrum = binned_spectrum(surface, order) if (psd_file or plot or surface.is_profile) else None
     document = {**result.as_dict(), "points": surface.heights.size}

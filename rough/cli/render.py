@@ -59,9 +59,9 @@ def render(surfaces, inputs, haptics, speeds, duration, press, hand_mass, hand_d
         if window is not None:
             surface = surface.crop(window[0], window[1] if not surface.is_profile else None)
         if fill:
-            from ..fractal.resample import filled
+            from ..fractal.resample import fill_invalid
 
-            surface = surface.derive("fill", {}, heights=filled(surface))
+            surface = fill_invalid(surface)
         if tip is not None:
             from ..metrology.tip import traced
 

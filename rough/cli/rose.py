@@ -33,13 +33,12 @@ def rose(surface, input, step, width, band, resolution, order, sampling, fill, p
         rough rose --step 15 --plot rose.png --json fault.x3p
         rough synth --size 1024x1024 --spacing 10um --anisotropy 2.2,1um,2.5,3um,30 | rough rose
     """
-    import numpy as np
 
-    from ..fractal.resample import filled
+    from ..fractal.resample import fill_invalid
     from ..fractal.rose import rose as directions
 
-    if fill and np.isnan(surface.heights).any():
-        surface = surface.derive("fill", {}, heights=filled(surface))
+    if fill:
+        surface = fill_invalid(surface)
     result = directions(surface, step=step, width=width, band=band, resolution=resolution, order=order, sampling=sampling)
     if plot:
         from .. import plots

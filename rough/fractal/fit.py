@@ -230,14 +230,21 @@ def _band_of(frequencies):
 # -- maps: ring-binned Whittle -------------------------------------------------------------
 
 
-def _whittle_map(surface, order, band, resolution, sampling, sector):
+def map_band(surface, band, sampling):
+    """``(step, low, high)`` of a map's ring fit (1/m): the ring spacing (the coarser of
+    the two axes' frequency steps) and ``band`` with its open ends set to the defaults,
+    from the LOWEST_RING-th ring up to :func:`default_top` of the smaller Nyquist frequency."""
     ny, nx = surface.heights.shape
     dx, dy = surface.spacing
     step = max(1 / (nx * dx), 1 / (ny * dy))
-    nyquist = min(0.5 / dx, 0.5 / dy)
     low, high = band or (None, None)
     low = LOWEST_RING * step if low is None else low
-    high = default_top(surface, nyquist, sampling) if high is None else high
+    high = default_top(surface, min(0.5 / dx, 0.5 / dy), sampling) if high is None else high
+    return step, low, high
+
+
+def _whittle_map(surface, order, band, resolution, sampling, sector):
+    step, low, high = map_band(surface, band, sampling)
     field, power = windowed_map(surface, order)
     refuse_flat(field, surface.heights)
     rings = ring_spectrum(field, power, surface.spacing, low, high, step, sector)

@@ -69,6 +69,14 @@ def _ratio(old, new):
     return ratio
 
 
+def fill_invalid(surface):
+    """``surface`` with its invalid points filled (see :func:`filled`), recorded as a
+    ``fill`` step; unchanged when every point is valid."""
+    if not np.isnan(surface.heights).any():
+        return surface
+    return surface.derive("fill", {}, heights=filled(surface))
+
+
 def filled(surface):
     """The heights with invalid points filled: linear interpolation along a profile,
     scikit-image's biharmonic inpainting in a map."""

@@ -25,7 +25,7 @@ import math
 import numpy as np
 
 from ..errors import InputError
-from .fit import LOWEST_RING, default_top, refuse_flat, ring_fit, sampling_of, warn_at_edge
+from .fit import map_band, refuse_flat, ring_fit, sampling_of, warn_at_edge
 from .psd import sector_spectra, windowed_map
 
 
@@ -75,11 +75,7 @@ def rose(surface, step=10.0, width=None, band=None, resolution=None, order=1, sa
         raise InputError(f"the step must divide 180° and the width lie in (0°, 180°]: step {step}°, width {width}°")
     sampling = sampling or sampling_of(surface)
     resolution = resolution or min(surface.spacing)
-    ny, nx = surface.heights.shape
-    frequency_step = max(1 / (nx * surface.spacing[0]), 1 / (ny * surface.spacing[1]))
-    low, high = band or (None, None)
-    low = LOWEST_RING * frequency_step if low is None else low
-    high = default_top(surface, min(0.5 / d for d in surface.spacing), sampling) if high is None else high
+    frequency_step, low, high = map_band(surface, band, sampling)
     from scipy import fft
 
     field, power = windowed_map(surface, order)

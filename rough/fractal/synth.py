@@ -69,8 +69,7 @@ def synthesize_map(points, spacing, dimension, amplitude=None, rq=None, resoluti
     dx, dy = spacing
     if anisotropy is not None:
         dimension, amplitude = anisotropy[0], anisotropy[1]
-        for value in anisotropy[2:4:2]:
-            model.check_dimension(value, profile=False)
+        model.check_dimension(anisotropy[2], profile=False)
         if rq is not None:
             raise InputError("give the anisotropy's C values or --rq, not both")
     model.check_dimension(dimension, profile=False)
