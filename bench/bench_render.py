@@ -8,9 +8,6 @@ and a real-time run's period jitter (goal p99 ≤ 50 µs, no deadline missed by 
 
 import argparse
 import os
-import sys
-
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from rough import __version__
 from rough.fractal.resample import resample

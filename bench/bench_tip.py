@@ -10,12 +10,8 @@ the tip's footprint in samples.
 
 import argparse
 import os
-import sys
 
 import numpy as np
-
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-
 from timing import median_time
 
 from rough import Surface, __version__

@@ -58,10 +58,6 @@ def logical(low, high):
     return _signed(0x14, low) + _signed(0x24, high)
 
 
-def physical(low, high):
-    return _signed(0x34, low) + _signed(0x44, high)
-
-
 def size_count(size, count):
     return _item(0x74, size) + _item(0x94, count)
 

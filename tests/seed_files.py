@@ -4,11 +4,12 @@ mutation tests (tests/test_fuzz.py) and the coverage-guided fuzzer
 
 import gzip
 import io
-import struct
 
 import numpy as np
 
 from rough import Surface
+
+from format_files import al3d_file, sdf_binary
 
 MAP = np.array([[1.0, 2.0, np.nan, 4.0], [5.0, 6.0, 7.0, 8.0], [9.0, 10.0, 11.0, 12.0]]) * 1e-6
 PROFILE = np.array([0.0, 1.5, -2.0, 3.25, 0.5, 1.0]) * 1e-6
@@ -35,22 +36,8 @@ def seeds():
     result["grid.xyz"] = b"0 0 1\n1 0 2\n0 1 3\n1 1 4\n0 2 5\n1 2 6\n"
     result["ascii.sdf"] = (b"aISO-1.0\nManufacID = seed\nNumPoints = 3\nNumProfiles = 2\nXscale = 1e-6\nYscale = 1e-6\n"
                            b"Zscale = 1e-6\nDataType = 7\n*\n1 2 BAD\n4 5 6\n*\n")
-    result["binary.sdf"] = struct.pack("<8s10s12s12sHHddddBBB", b"bISO-1.0", b"seed", b"010120201200", b"010120201200",
-                                       3, 2, 1e-6, 2e-6, 1e-9, 1e-9, 0, 5, 0) + np.arange(6, dtype="<i2").tobytes()
-    result["depth.al3d"] = _al3d(np.arange(15, dtype="<f4").reshape(3, 5) * np.float32(1e-6))
+    result["binary.sdf"] = sdf_binary(3, 2, 1e-6, 2e-6, datatype=5, body=np.arange(6, dtype="<i2").tobytes(), manufacturer=b"seed")
+    result["depth.al3d"] = al3d_file(np.arange(15, dtype="<f4").reshape(3, 5) * np.float32(1e-6),
+                                     tags={"CreatingApplication": "seed"})
     result["map.tsv.gz"] = gzip.compress(result["map.tsv"])
     return result
-
-
-def _al3d(depth):
-    rows, cols = depth.shape
-    tags = {"Cols": cols, "Rows": rows, "PixelSizeXMeter": 1e-6, "PixelSizeYMeter": 1e-6, "InvalidPixelValue": 3e15,
-            "CreatingApplication": "seed"}
-    tags["DepthImageOffset"] = 17 + 52 * (len(tags) + 3) + 256
-
-    def tag(key, value):
-        return str(key).encode().ljust(20, b"\0") + str(value).encode().ljust(30, b"\0") + b"\r\n"
-
-    head = b"AliconaImaging\0\r\n" + tag("Version", 1) + tag("TagCount", len(tags)) + b"".join(tag(k, v) for k, v in tags.items())
-    stride = (cols * 4 + 7) // 8 * 8
-    return head + bytes(254) + b"\r\n" + b"".join(row.tobytes().ljust(stride, b"\0") for row in depth)

@@ -2,13 +2,14 @@
 and on the third-party files of ../shared/data."""
 
 import io
-import struct
 
 import numpy as np
 import pytest
 
 from rough.errors import FormatError
 from rough.io import ReadOptions, read, read_bytes
+
+from format_files import al3d_file, gsf, sdf_binary
 
 UM = 1e-6
 
@@ -103,11 +104,6 @@ def test_plain_matrix_of_heights():
 # -- GSF ------------------------------------------------------------------------------
 
 
-def gsf(header_lines, values):
-    header = ("Gwyddion Simple Field 1.0\n" + "".join(f"{line}\n" for line in header_lines)).encode()
-    return header + bytes(4 - len(header) % 4) + np.asarray(values, "<f4").tobytes()
-
-
 @pytest.mark.parametrize("title", ["", "a", "ab", "abc"])  # every header length modulo 4
 def test_gsf_padding_and_units(title):
     blob = gsf(["XRes = 3", "YRes = 2", "XReal = 3", "YReal = 4", "XYUnits = mm", "ZUnits = um", f"Title = {title}"], np.arange(6))
@@ -176,9 +172,7 @@ def test_npy_without_spacing_is_refused():
 
 
 def test_binary_sdf():
-    header = struct.pack("<8s10s12s12sHHddddBBB", b"bISO-1.0", b"TEST", b"010120201200", b"010120201200",
-                         3, 2, 1e-6, 2e-6, 1e-9, 1e-9, 0, 5, 0)
-    surface = read_bytes(header + np.array([1, 2, 3, 4, 5, -6], "<i2").tobytes())
+    surface = read_bytes(sdf_binary(3, 2, 1e-6, 2e-6, datatype=5, body=np.array([1, 2, 3, 4, 5, -6], "<i2").tobytes()))
     np.testing.assert_allclose(surface.heights, np.array([[1, 2, 3], [4, 5, -6]]) * 1e-9)
     assert surface.spacing == (1e-6, 2e-6)
     assert surface.metadata["date"] == "2020-01-01T12:00:00"
@@ -188,27 +182,6 @@ def test_ascii_sdf_with_bad_points():
     body = "aISO-1.0\nNumPoints = 2\nNumProfiles = 2\nXscale = 1e-6\nYscale = 1e-6\nZscale = 1e-6\nDataType = 7\n*\n1 BAD\n3 4\n*\n"
     surface = text(body)
     assert np.isnan(surface.heights[0, 1]) and surface.heights[1, 1] == pytest.approx(4e-6)
-
-
-def al3d_file(depth, pixel=(1e-6, 2e-6), invalid=3e15, tags=None, cut=0):
-    """An AL3D file as MeasureSuite writes one: tags, a 256-byte comment, float32 rows
-    padded to 8 bytes."""
-    rows, cols = depth.shape
-    header = {"Cols": cols, "Rows": rows, "PixelSizeXMeter": pixel[0], "PixelSizeYMeter": pixel[1],
-              "InvalidPixelValue": invalid, "NumberOfPlanes": 0, "CreatingApplication": "hand-made"}
-    header.update(tags or {})
-    offset = 17 + 52 * (len(header) + 3) + 256
-    header["DepthImageOffset"] = header.get("DepthImageOffset", offset)
-
-    def tag(key, value):
-        return str(key).encode().ljust(20, b"\0") + str(value).encode().ljust(30, b"\0") + b"\r\n"
-
-    blob = b"AliconaImaging\0\r\n" + tag("Version", 1) + tag("TagCount", len(header))
-    blob += b"".join(tag(k, v) for k, v in header.items()) + b"\0" * 254 + b"\r\n"
-    stride = (cols * 4 + 7) // 8 * 8
-    body = b"".join(row.astype("<f4").tobytes().ljust(stride, b"\xaa") for row in depth)
-    blob += body
-    return blob[: len(blob) - cut]
 
 
 def test_al3d_rows_padded_to_eight_bytes_and_invalid_points():

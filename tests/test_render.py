@@ -452,7 +452,6 @@ def test_a_stalled_loop_is_zeroed_within_two_ticks_of_its_watchdog():
 def test_a_vanished_joystick_leaves_no_force():
     """Reads fail (the device is going away) while writes still arrive: the zero is
     written in the same tick; when writes fail too, closing does not raise."""
-    from pid_descriptor import Layout  # noqa: F401 -- the virtual device's layout
     from virtual_joystick import FakeHandle, PidJoystick
 
     from rough.render.hid import DeviceGone, Joystick
@@ -472,7 +471,7 @@ def test_a_vanished_joystick_leaves_no_force():
 
     handle.read = failing_read
     with pytest.raises(DeviceGone):
-        run(stick, [Track(np.full(101, 1e-3), 1e-4)], QuasiStatic(), None, Settings(duration=1.0, watchdog=1.0))
+        run(stick, [RAISED], QuasiStatic(), None, Settings(duration=1.0, watchdog=1.0))
     assert device.force() == (0.0, 0.0) and handle.closed
 
 

@@ -17,6 +17,7 @@ import numpy as np
 HERE = pathlib.Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
 
+from format_files import al3d_file, gsf, sdf_binary
 from x3p_files import x3p_file
 
 GRID = np.arange(12.0).reshape(3, 4) * 1e-6
@@ -163,13 +164,6 @@ def exr_cases():
 # -- GSF ---------------------------------------------------------------------------------------
 
 
-def gsf(header_lines, values, pad=True):
-    header = ("Gwyddion Simple Field 1.0\n" + "".join(f"{line}\n" for line in header_lines)).encode()
-    if pad:
-        header += bytes(4 - len(header) % 4)
-    return header + np.asarray(values, "<f4").tobytes()
-
-
 def gsf_cases():
     case("gsf-no-nul.gsf", b"Gwyddion Simple Field 1.0\nXRes = 2\nYRes = 2\n", "NUL", "header never ends")
     case("gsf-wrong-version.gsf", gsf(["XRes = 2", "YRes = 2"], np.zeros(4)).replace(b"1.0", b"9.9", 1), "", "version 9.9")
@@ -237,11 +231,6 @@ def npy_cases():
 # -- SDF and AL3D -----------------------------------------------------------------------------------
 
 
-def sdf_binary(points, profiles, xscale=1e-6, yscale=1e-6, zscale=1e-9, datatype=7, body=b""):
-    return struct.pack("<8s10s12s12sHHddddBBB", b"bISO-1.0", b"HOSTILE", b"010120201200", b"010120201200",
-                       points, profiles, xscale, yscale, zscale, 1e-9, 0, datatype, 0) + body
-
-
 def sdf_cases():
     ascii_header = "aISO-1.0\nNumPoints = {n}\nNumProfiles = {m}\nXscale = {x}\nYscale = 1e-6\nZscale = 1e-6\nDataType = 7\n*\n"
     case("sdf-ascii-count.sdf", (ascii_header.format(n=3, m=2, x=1e-6) + "1 2 3\n*\n").encode(), "holds 3 values",
@@ -254,24 +243,14 @@ def sdf_cases():
     case("sdf-unclosed-header.sdf", b"aISO-1.0\nNumPoints = 2\nNumProfiles = 1\n", "not closed", "header never ends")
 
 
-def al3d(tags, body=b"", comment=True):
-    def tag(key, value):
-        return str(key).encode().ljust(20, b"\0") + str(value).encode().ljust(30, b"\0") + b"\r\n"
-
-    blob = b"AliconaImaging\0\r\n" + tag("Version", 1) + tag("TagCount", len(tags)) + b"".join(tag(k, v) for k, v in tags.items())
-    return blob + (bytes(254) + b"\r\n" if comment else b"") + body
-
-
 def al3d_cases():
-    offset = 17 + 52 * 8 + 256
-    base = {"Cols": 2, "Rows": 2, "PixelSizeXMeter": 1e-6, "PixelSizeYMeter": 1e-6, "InvalidPixelValue": 1e30,
-            "DepthImageOffset": offset}
-    case("al3d-truncated-header.al3d", al3d(base)[:120], "truncated", "cut inside the tags")
-    case("al3d-absurd-size.al3d", al3d({**base, "Cols": 10**9, "Rows": 10**9}, bytes(16)), "runs past the end", "10^18 pixels")
-    case("al3d-zero-pixel.al3d", al3d({**base, "PixelSizeXMeter": 0}, bytes(16)), "pixel size", "pixel size 0")
-    case("al3d-tag-count.al3d", al3d(base)[:17 + 52] + b"TagCount".ljust(20, b"\0") + b"99999999".ljust(30, b"\0") + b"\r\n",
+    zeros = np.zeros((2, 2))
+    case("al3d-truncated-header.al3d", al3d_file(zeros)[:120], "truncated", "cut inside the tags")
+    case("al3d-absurd-size.al3d", al3d_file(zeros, tags={"Cols": 10**9, "Rows": 10**9}), "runs past the end", "10^18 pixels")
+    case("al3d-zero-pixel.al3d", al3d_file(zeros, pixel=(0, 1e-6)), "pixel size", "pixel size 0")
+    case("al3d-tag-count.al3d", al3d_file(zeros)[:17 + 52] + b"TagCount".ljust(20, b"\0") + b"99999999".ljust(30, b"\0") + b"\r\n",
          "tag count", "TagCount 99999999")
-    case("al3d-all-invalid.al3d", al3d(base, np.full(4, 1e30, "<f4").tobytes()), "no valid points", "every pixel invalid")
+    case("al3d-all-invalid.al3d", al3d_file(np.full((2, 2), 1e30), invalid=1e30), "no valid points", "every pixel invalid")
 
 
 # -- compressed and anything else ---------------------------------------------------------------------
