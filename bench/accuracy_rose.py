@@ -19,9 +19,11 @@ def isotropic(maps=60):
         p_dimension.append(result.isotropy_p_value["fractal_dimension"])
         p_amplitude.append(result.isotropy_p_value["amplitude_coefficient"])
         str_ratio.append(result.Str)
-    print(f"isotropic 512², {maps} maps: rejected at 5 %: Ds {np.mean(np.array(p_dimension) < 0.05):.3f}, "
-          f"C {np.mean(np.array(p_amplitude) < 0.05):.3f}; Str {np.nanmin(str_ratio):.3f} to {np.nanmax(str_ratio):.3f} "
-          f"(median {np.nanmedian(str_ratio):.3f})")
+    print(
+        f"isotropic 512², {maps} maps: rejected at 5 %: Ds {np.mean(np.array(p_dimension) < 0.05):.3f}, "
+        f"C {np.mean(np.array(p_amplitude) < 0.05):.3f}; Str {np.nanmin(str_ratio):.3f} to {np.nanmax(str_ratio):.3f} "
+        f"(median {np.nanmedian(str_ratio):.3f})"
+    )
 
 
 def anisotropic(angles=(0, 30, 45, 75, 110, 160), seeds=8):
@@ -36,11 +38,15 @@ def anisotropic(angles=(0, 30, 45, 75, 110, 160), seeds=8):
                 log_c_error.append(math.log(fit["amplitude"] / amplitude))
                 z_dimension.append(dimension_error[-1] / fit["dimension_error"])
                 z_amplitude.append(log_c_error[-1] / (fit["amplitude_error"] / fit["amplitude"]))
-    print(f"anisotropic 512² (Ds 2.2/2.5, C 1/4 µm), {len(direction_error)} maps: principal direction error "
-          f"median {np.median(direction_error):.2f}°, max {np.max(direction_error):.2f}°")
+    print(
+        f"anisotropic 512² (Ds 2.2/2.5, C 1/4 µm), {len(direction_error)} maps: principal direction error "
+        f"median {np.median(direction_error):.2f}°, max {np.max(direction_error):.2f}°"
+    )
     for name, errors, z in (("Ds", dimension_error, z_dimension), ("log C", log_c_error, z_amplitude)):
-        print(f"  {name}: bias {np.mean(errors):+.4f}, RMS {np.sqrt(np.mean(np.square(errors))):.4f}, "
-              f"SD of error/SE {np.std(z):.2f}")
+        print(
+            f"  {name}: bias {np.mean(errors):+.4f}, RMS {np.sqrt(np.mean(np.square(errors))):.4f}, "
+            f"SD of error/SE {np.std(z):.2f}"
+        )
 
 
 if __name__ == "__main__":

@@ -35,7 +35,9 @@ def startup(repeat):
     rough_cli = os.path.join(os.path.dirname(sys.executable), "rough")
     help_time = median_time(lambda: subprocess.run([rough_cli, "--help"], check=True, capture_output=True), repeat * 5)
     bare = median_time(lambda: subprocess.run([sys.executable, "-c", "pass"], check=True), repeat * 5)
-    print(f"start-up   rough --help {help_time * 1e3:7.1f} ms   python -c pass {bare * 1e3:6.1f} ms   ratio {help_time / bare:5.2f}×   (goal ≤ 150 ms)")
+    print(
+        f"start-up   rough --help {help_time * 1e3:7.1f} ms   python -c pass {bare * 1e3:6.1f} ms   ratio {help_time / bare:5.2f}×   (goal ≤ 150 ms)"
+    )
 
 
 def pipe(path, repeat):
@@ -52,7 +54,9 @@ def formats(surface, folder, repeat):
     raw_path = os.path.join(folder, "raw.f8")
     write_raw = median_time(lambda: surface.heights.tofile(raw_path), repeat)
     read_raw = median_time(lambda: np.fromfile(raw_path), repeat)
-    print(f"raw dump   write {write_raw:7.3f} s   read {read_raw:7.3f} s   ({surface.heights.nbytes / 1e6:.0f} MB float64)")
+    print(
+        f"raw dump   write {write_raw:7.3f} s   read {read_raw:7.3f} s   ({surface.heights.nbytes / 1e6:.0f} MB float64)"
+    )
     for fmt in ("x3p", "exr", "gsf", "npy", "tsv"):
         path = os.path.join(folder, f"map.{fmt}")
         times = 1 if fmt == "tsv" else repeat
@@ -72,7 +76,9 @@ def main():
     options = parser.parse_args()
     heights = np.random.default_rng(0).standard_normal((options.size, options.size)) * 1e-6
     surface = rough.Surface(heights, (1e-6, 1e-6))
-    print(f"rough {rough.__version__}, {options.size}×{options.size} map, median of {options.repeat} runs, {os.cpu_count()} CPUs")
+    print(
+        f"rough {rough.__version__}, {options.size}×{options.size} map, median of {options.repeat} runs, {os.cpu_count()} CPUs"
+    )
     with tempfile.TemporaryDirectory(dir=os.environ.get("TMPDIR")) as folder:
         startup(options.repeat)
         surface.write(os.path.join(folder, "pipe.x3p"))

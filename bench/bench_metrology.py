@@ -22,8 +22,10 @@ def report(name, surface, repeat):
     baseline = median_time(lambda: np.std(surface.heights), repeat)
     features = median_time(lambda: parameters(surface), repeat)
     levelling = median_time(lambda: detrend(surface, order=2), repeat)
-    print(f"{name:<22} parameters {features:7.3f} s = {features / baseline:6.0f}× numpy.std ({baseline * 1e3:.1f} ms)   "
-          f"detrend order 2 {levelling:6.3f} s = {levelling / baseline:5.0f}×")
+    print(
+        f"{name:<22} parameters {features:7.3f} s = {features / baseline:6.0f}× numpy.std ({baseline * 1e3:.1f} ms)   "
+        f"detrend order 2 {levelling:6.3f} s = {levelling / baseline:5.0f}×"
+    )
 
 
 def main():

@@ -35,16 +35,20 @@ def simulated(track):
             factors.append(result.timing()["realtime_factor"])
         best = sorted(factors)[1]
         per_tick = 1e6 / (best * 1000)
-        print(f"sim {name:<24} {result.ticks} ticks: {best:6.0f}× real time ({per_tick:.2f} µs per 1 ms tick)   goal ≥ 500×")
+        print(
+            f"sim {name:<24} {result.ticks} ticks: {best:6.0f}× real time ({per_tick:.2f} µs per 1 ms tick)   goal ≥ 500×"
+        )
 
 
 def realtime(track, seconds):
     result = simulate(track, 0.02, QuasiStatic(), None, Settings(duration=seconds, realtime=True))
     timing = result.timing()
     late = timing["max_lateness"] * 1e3
-    print(f"real time {seconds:g} s at 1 kHz ({timing['scheduling']}): rate {timing['rate']:.2f} Hz, period jitter p50 {timing['jitter_p50'] * 1e6:.1f} µs, "
-          f"p99 {timing['jitter_p99'] * 1e6:.1f} µs, max {timing['jitter_max'] * 1e6:.1f} µs; "
-          f"missed deadlines {timing['missed_deadlines']}, latest tick {late:.3f} ms late   goal p99 ≤ 50 µs, lateness ≤ 1 ms")
+    print(
+        f"real time {seconds:g} s at 1 kHz ({timing['scheduling']}): rate {timing['rate']:.2f} Hz, period jitter p50 {timing['jitter_p50'] * 1e6:.1f} µs, "
+        f"p99 {timing['jitter_p99'] * 1e6:.1f} µs, max {timing['jitter_max'] * 1e6:.1f} µs; "
+        f"missed deadlines {timing['missed_deadlines']}, latest tick {late:.3f} ms late   goal p99 ≤ 50 µs, lateness ≤ 1 ms"
+    )
 
 
 def main():

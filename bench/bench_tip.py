@@ -25,8 +25,10 @@ def measure(surface, label, transform, repeat):
     baseline = median_time(lambda: transform(surface.heights), max(repeat, 3))
     path = median_time(lambda: traced(surface, RADIUS), repeat)
     envelope = median_time(lambda: closing_envelope(surface, RADIUS), repeat)
-    print(f"{label:<22} traced {path:7.2f} s = {path / baseline:6.0f}× one FFT ({baseline * 1e3:.1f} ms)   "
-          f"closing envelope {envelope:7.2f} s = {envelope / baseline:6.0f}×")
+    print(
+        f"{label:<22} traced {path:7.2f} s = {path / baseline:6.0f}× one FFT ({baseline * 1e3:.1f} ms)   "
+        f"closing envelope {envelope:7.2f} s = {envelope / baseline:6.0f}×"
+    )
 
 
 def main():

@@ -41,7 +41,12 @@ def features_figure(surface, features=(), density=None):
     if surface.is_profile:
         top.plot(surface.positions(0) * MM, heights * UM, lw=0.7, color="0.2")
         for feature in features:
-            top.axvspan(feature.start * MM, feature.end * MM, color="tab:red" if feature.kind == "peak" else "tab:blue", alpha=0.2)
+            top.axvspan(
+                feature.start * MM,
+                feature.end * MM,
+                color="tab:red" if feature.kind == "peak" else "tab:blue",
+                alpha=0.2,
+            )
         top.set_xlabel("x (mm)")
         top.set_ylabel("height (µm)")
         top.set_title(f"{surface.metadata.get('title', 'profile')}: {len(features)} features shaded")
@@ -75,8 +80,13 @@ def spectrum_figure(frequencies, density, fit, title="power spectrum"):
     low, high = fit.band
     grid = np.geomspace(low, high, 100)
     exponent = 5 - 2 * fit.fractal_dimension if fit.profile_dimension is None else 8 - 2 * fit.fractal_dimension
-    axes.loglog(grid * 1e-3, fit.psd_prefactor * grid**-exponent, color="tab:red", lw=2,
-                label=f"fit: {'D' if fit.profile_dimension is None else 'Ds'} = {fit.fractal_dimension:.4f} ± {fit.fractal_dimension_stderr:.4f}")
+    axes.loglog(
+        grid * 1e-3,
+        fit.psd_prefactor * grid**-exponent,
+        color="tab:red",
+        lw=2,
+        label=f"fit: {'D' if fit.profile_dimension is None else 'Ds'} = {fit.fractal_dimension:.4f} ± {fit.fractal_dimension_stderr:.4f}",
+    )
     axes.axvspan(low * 1e-3, high * 1e-3, color="tab:red", alpha=0.06, label="fit band")
     axes.set_xlabel("spatial frequency (1/mm)")
     axes.set_ylabel("PSD G(f) (m³)" if fit.profile_dimension is None else "ring-averaged P2 (m⁴)")
@@ -94,8 +104,13 @@ def rose_figure(rose, title="direction dependence"):
     figure, axes = plt.subplots(1, 2, subplot_kw={"projection": "polar"}, figsize=(10, 5))
     theta = np.radians(np.concatenate([rose.angles, np.add(rose.angles, 180.0), [rose.angles[0] + 360.0]]))
     panels = (
-        (axes[0], np.array(rose.amplitude_coefficient) * 1e9, np.array(rose.amplitude_coefficient_stderr) * 1e9,
-         f"C(θ) (nm) at η = {rose.resolution * 1e6:.4g} µm", "tab:red"),
+        (
+            axes[0],
+            np.array(rose.amplitude_coefficient) * 1e9,
+            np.array(rose.amplitude_coefficient_stderr) * 1e9,
+            f"C(θ) (nm) at η = {rose.resolution * 1e6:.4g} µm",
+            "tab:red",
+        ),
         (axes[1], np.array(rose.fractal_dimension), np.array(rose.fractal_dimension_stderr), "Ds(θ)", "tab:blue"),
     )
     for axis, values, errors, label, colour in panels:
@@ -110,8 +125,11 @@ def rose_figure(rose, title="direction dependence"):
             for direction in (angle, angle + 180):
                 axis.plot(np.radians([direction, direction]), [inner, outer], style, color="0.3", lw=1)
         axis.set_title(label, pad=14)
-    figure.suptitle(f"{title}\nprincipal wavevector {rose.principal_direction:.1f}° (solid), lay {rose.lay_direction:.1f}° (dashed); "
-                    f"Str {'undefined' if np.isnan(rose.Str) else format(rose.Str, '.3g')}, Std {rose.Std:.1f}°", fontsize=10)
+    figure.suptitle(
+        f"{title}\nprincipal wavevector {rose.principal_direction:.1f}° (solid), lay {rose.lay_direction:.1f}° (dashed); "
+        f"Str {'undefined' if np.isnan(rose.Str) else format(rose.Str, '.3g')}, Std {rose.Std:.1f}°",
+        fontsize=10,
+    )
     figure.tight_layout()
     return figure
 
@@ -121,8 +139,9 @@ def force_figure(runs):
     height under the stylus and the hand's height (top), and F_y and F_x against the
     position along the profile (bottom), with the ticks out of contact shaded."""
     plt = _pyplot()
-    figure, axes = plt.subplots(2, len(runs), figsize=(5.5 * len(runs), 6), sharex="col", squeeze=False,
-                                gridspec_kw={"height_ratios": [1, 1.4]})
+    figure, axes = plt.subplots(
+        2, len(runs), figsize=(5.5 * len(runs), 6), sharex="col", squeeze=False, gridspec_kw={"height_ratios": [1, 1.4]}
+    )
     for column, (label, result) in enumerate(runs):
         trace = result.trace
         x = trace["x"] * MM
@@ -134,8 +153,10 @@ def force_figure(runs):
         for axis in (top, bottom):
             _shade(axis, x, ~trace["contact"])
         title = label if result.speed is None else f"{result.speed * 1e3:g} mm/s"
-        top.set_title(f"{title}: F_y std {trace['F_y'].std():.3f} N, out of contact {100 * (1 - trace['contact'].mean()):.1f} %",
-                      fontsize=9)
+        top.set_title(
+            f"{title}: F_y std {trace['F_y'].std():.3f} N, out of contact {100 * (1 - trace['contact'].mean()):.1f} %",
+            fontsize=9,
+        )
         top.set_ylabel("height (mm)")
         bottom.set_ylabel("force on the hand (N)")
         bottom.set_xlabel("x (mm)")
@@ -171,7 +192,9 @@ def percentage_figure(study, set_ids):
         for k, dimension in enumerate(levels_d):
             label = f"D = {dimension:g}"
             for g, rq in enumerate(levels_rq):
-                cell = next((c for c in cells if math.isclose(c[1], dimension) and math.isclose(c[2], rq, rel_tol=1e-6)), None)
+                cell = next(
+                    (c for c in cells if math.isclose(c[1], dimension) and math.isclose(c[2], rq, rel_tol=1e-6)), None
+                )
                 if cell is None:
                     continue
                 x = g + (k - (len(levels_d) - 1) / 2) * width
@@ -182,7 +205,9 @@ def percentage_figure(study, set_ids):
         axis.set_xticks(range(len(levels_rq)), [f"Rq {rq * 1e3:.4g} mm" for rq in levels_rq])
         axis.set_ylim(0, 110)
         axis.set_ylabel("judged rougher than the reference (%)")
-        axis.set_title(f"set {set_id}: reference D = {reference['dimension']:g}, Rq = {reference['rq'] * 1e3:.4g} mm", fontsize=9)
+        axis.set_title(
+            f"set {set_id}: reference D = {reference['dimension']:g}, Rq = {reference['rq'] * 1e3:.4g} mm", fontsize=9
+        )
         handles, labels = axis.get_legend_handles_labels()
         unique = dict(zip(labels, handles))
         axis.legend(unique.values(), unique.keys(), fontsize=7, loc="upper left")

@@ -23,8 +23,10 @@ def check_size(shape, what):
     """Refuse to make a surface of ``shape`` past :data:`MAX_POINTS` (before allocating it)."""
     points = math.prod(shape)
     if points > MAX_POINTS:
-        raise InputError(f"{what} would hold {points:,} points, more than rough's limit of {MAX_POINTS:,} "
-                         "(16384 × 16384); choose a coarser spacing or a smaller size")
+        raise InputError(
+            f"{what} would hold {points:,} points, more than rough's limit of {MAX_POINTS:,} "
+            "(16384 × 16384); choose a coarser spacing or a smaller size"
+        )
 
 
 @dataclass(frozen=True)
@@ -180,5 +182,7 @@ def _index_range(bound, origin, spacing, count, name):
     stop = count if high is None else min(count, int(np.floor((high - origin) / spacing + 0.5)) + 1)
     if stop - start < 2:
         last = origin + spacing * (count - 1)
-        raise InputError(f"the {name} range {bound} holds fewer than two samples (the data span {origin:g} to {last:g} m)")
+        raise InputError(
+            f"the {name} range {bound} holds fewer than two samples (the data span {origin:g} to {last:g} m)"
+        )
     return start, stop

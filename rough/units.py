@@ -25,18 +25,32 @@ METRES_PER_UNIT = {
 }
 
 _WORDS = {
-    "metre": "m", "meter": "m", "metres": "m", "meters": "m",
-    "millimetre": "mm", "millimeter": "mm", "millimetres": "mm", "millimeters": "mm",
-    "micrometre": "um", "micrometer": "um", "micrometres": "um", "micrometers": "um",
-    "micron": "um", "microns": "um",
-    "nanometre": "nm", "nanometer": "nm", "nanometres": "nm", "nanometers": "nm",
-    "angstrom": "A", "angstroms": "A", "ångström": "A",
-    "inch": "in", "inches": "in",
+    "metre": "m",
+    "meter": "m",
+    "metres": "m",
+    "meters": "m",
+    "millimetre": "mm",
+    "millimeter": "mm",
+    "millimetres": "mm",
+    "millimeters": "mm",
+    "micrometre": "um",
+    "micrometer": "um",
+    "micrometres": "um",
+    "micrometers": "um",
+    "micron": "um",
+    "microns": "um",
+    "nanometre": "nm",
+    "nanometer": "nm",
+    "nanometres": "nm",
+    "nanometers": "nm",
+    "angstrom": "A",
+    "angstroms": "A",
+    "ångström": "A",
+    "inch": "in",
+    "inches": "in",
 }
 
-_NUMBER_AND_UNIT = re.compile(
-    r"^\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)\s*([^\s\d.+-][^\s]*)?\s*$"
-)
+_NUMBER_AND_UNIT = re.compile(r"^\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)\s*([^\s\d.+-][^\s]*)?\s*$")
 
 
 def metres_per(unit):
@@ -100,7 +114,9 @@ def format_quantity(value, unit, digits=5):
     return f"{value:.{digits}g}"
 
 
-_FREQUENCY = re.compile(r"^\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)\s*(?:(?:1?/|per\s*)\s*([^\s\d.+-][^\s]*))?\s*$")
+_FREQUENCY = re.compile(
+    r"^\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)\s*(?:(?:1?/|per\s*)\s*([^\s\d.+-][^\s]*))?\s*$"
+)
 
 
 def parse_frequency(text, default_unit="mm"):
@@ -149,6 +165,7 @@ def parse_quantity(text, kind, default_unit=None):
 def format_unit(value, kind, digits=4):
     """``value`` (SI) printed in the unit the sources use for ``kind``:
     N, N/mm, N·s/m, g, mm/s, s, Hz."""
-    shown = {"stiffness": (1e-3, "N/mm"), "mass": (1e3, "g"), "speed": (1e3, "mm/s"),
-             "damping": (1.0, "N·s/m")}.get(kind, (1.0, QUANTITIES[kind][0]))
+    shown = {"stiffness": (1e-3, "N/mm"), "mass": (1e3, "g"), "speed": (1e3, "mm/s"), "damping": (1.0, "N·s/m")}.get(
+        kind, (1.0, QUANTITIES[kind][0])
+    )
     return f"{value * shown[0]:.{digits}g} {shown[1]}"

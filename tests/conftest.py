@@ -30,7 +30,11 @@ def rough(*args, input=None, check=False, env=None, timeout=120):
     environment = {**os.environ, **(env or {})}
     result = subprocess.run(
         [sys.executable, "-m", "rough", *map(str, args)],
-        check=False, input=input, capture_output=True, env=environment, timeout=timeout,
+        check=False,
+        input=input,
+        capture_output=True,
+        env=environment,
+        timeout=timeout,
     )
     if check and result.returncode != 0:
         raise AssertionError(f"rough {' '.join(map(str, args))} failed ({result.returncode}): {result.stderr.decode()}")

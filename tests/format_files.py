@@ -14,16 +14,40 @@ def gsf(header_lines, values):
 
 def sdf_binary(points, profiles, xscale=1e-6, yscale=1e-6, zscale=1e-9, datatype=7, body=b"", manufacturer=b"TEST"):
     """A binary ISO 25178-71 SDF: the fixed header, then ``body`` as given."""
-    return struct.pack("<8s10s12s12sHHddddBBB", b"bISO-1.0", manufacturer, b"010120201200", b"010120201200",
-                       points, profiles, xscale, yscale, zscale, 1e-9, 0, datatype, 0) + body
+    return (
+        struct.pack(
+            "<8s10s12s12sHHddddBBB",
+            b"bISO-1.0",
+            manufacturer,
+            b"010120201200",
+            b"010120201200",
+            points,
+            profiles,
+            xscale,
+            yscale,
+            zscale,
+            1e-9,
+            0,
+            datatype,
+            0,
+        )
+        + body
+    )
 
 
 def al3d_file(depth, pixel=(1e-6, 2e-6), invalid=3e15, tags=None, cut=0):
     """An AL3D file as MeasureSuite writes one: tags, a 256-byte comment, float32 rows
     padded to 8 bytes; ``tags`` override the header, ``cut`` drops bytes at the end."""
     rows, cols = depth.shape
-    header = {"Cols": cols, "Rows": rows, "PixelSizeXMeter": pixel[0], "PixelSizeYMeter": pixel[1],
-              "InvalidPixelValue": invalid, "NumberOfPlanes": 0, "CreatingApplication": "hand-made"}
+    header = {
+        "Cols": cols,
+        "Rows": rows,
+        "PixelSizeXMeter": pixel[0],
+        "PixelSizeYMeter": pixel[1],
+        "InvalidPixelValue": invalid,
+        "NumberOfPlanes": 0,
+        "CreatingApplication": "hand-made",
+    }
     header.update(tags or {})
     offset = 17 + 52 * (len(header) + 3) + 256
     header["DepthImageOffset"] = header.get("DepthImageOffset", offset)

@@ -99,7 +99,10 @@ def bad_inputs(tmp_path):
         "magic.dat": (bytes(range(256)) * 4, "unrecognised binary data"),
         "column.txt": (b"1.0\n2.0\n3.0\n", "needs the spacing"),
         "huge.x3p": (x3p_file(np.ones((2, 2)), size=(1000000, 1000000, 1)), "more than rough handles"),
-        "huge.gsf": (b"Gwyddion Simple Field 1.0\nXRes = 1000000\nYRes = 1000000\n\0\0\0\0" + bytes(16), "declares 1000000×1000000"),
+        "huge.gsf": (
+            b"Gwyddion Simple Field 1.0\nXRes = 1000000\nYRes = 1000000\n\0\0\0\0" + bytes(16),
+            "declares 1000000×1000000",
+        ),
     }
     for name, (content, _) in cases.items():
         (tmp_path / name).write_bytes(content)
@@ -157,7 +160,10 @@ def test_binary_output_to_a_terminal_is_refused(sample):
     try:
         result = subprocess.run(
             [sys.executable, "-m", "rough", "convert", str(sample["gsf"])],
-            check=False, stdout=terminal, stderr=subprocess.PIPE, timeout=60,
+            check=False,
+            stdout=terminal,
+            stderr=subprocess.PIPE,
+            timeout=60,
         )
     finally:
         os.close(terminal)
@@ -170,7 +176,10 @@ def test_closed_downstream_pipe_ends_quietly(tmp_path):
     Surface(np.zeros(200000), (1e-6,)).write(tmp_path / "long.x3p")
     pipeline = subprocess.run(
         f"{sys.executable} -m rough convert -f tsv {tmp_path / 'long.x3p'} | head -n 3",
-        check=False, shell=True, capture_output=True, timeout=60,
+        check=False,
+        shell=True,
+        capture_output=True,
+        timeout=60,
     )
     assert pipeline.stdout.decode().startswith("# rough")
     assert pipeline.stderr == b""
@@ -178,8 +187,11 @@ def test_closed_downstream_pipe_ends_quietly(tmp_path):
 
 def test_closed_pipe_status(tmp_path):
     Surface(np.zeros(200000), (1e-6,)).write(tmp_path / "long.x3p")
-    process = subprocess.Popen([sys.executable, "-m", "rough", "convert", "-f", "tsv", str(tmp_path / "long.x3p")],
-                               stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    process = subprocess.Popen(
+        [sys.executable, "-m", "rough", "convert", "-f", "tsv", str(tmp_path / "long.x3p")],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
     process.stdout.read(100)
     process.stdout.close()
     assert process.wait(timeout=60) == 141
@@ -188,8 +200,12 @@ def test_closed_pipe_status(tmp_path):
 
 def test_ctrl_c_exits_130_with_nothing_written(tmp_path):
     out = tmp_path / "never.x3p"
-    process = subprocess.Popen([sys.executable, "-m", "rough", "convert", "-o", str(out)],
-                               stdin=subprocess.PIPE, stderr=subprocess.PIPE, cwd=ROOT)
+    process = subprocess.Popen(
+        [sys.executable, "-m", "rough", "convert", "-o", str(out)],
+        stdin=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        cwd=ROOT,
+    )
     time.sleep(1.5)
     process.send_signal(signal.SIGINT)
     assert process.wait(timeout=30) == 130

@@ -41,11 +41,22 @@ def study(costa, tmp_path):
 # -- the paper's numbers and the design ---------------------------------------------------------
 
 
-@pytest.mark.parametrize("wald,printed", [
-    ("4.47037", "7.8085e-6"), ("-2.48803", ".0128"), ("-0.76212", ".446"), ("4.9217", "8.581e-7"),
-    ("-1.027", ".3044"), ("-1.815", ".0696"), ("-0.051", ".9593"), ("-1.734", ".0829"), ("-2.504", ".0123"),
-    ("-0.966", ".334"), ("0.719", ".4721"),
-])
+@pytest.mark.parametrize(
+    "wald,printed",
+    [
+        ("4.47037", "7.8085e-6"),
+        ("-2.48803", ".0128"),
+        ("-0.76212", ".446"),
+        ("4.9217", "8.581e-7"),
+        ("-1.027", ".3044"),
+        ("-1.815", ".0696"),
+        ("-0.051", ".9593"),
+        ("-1.734", ".0829"),
+        ("-2.504", ".0123"),
+        ("-0.966", ".334"),
+        ("0.719", ".4721"),
+    ],
+)
 def test_the_papers_wald_statistics_give_its_p_values(wald, printed):
     """Tables 1-2 of the paper: p = 2(1 - Φ(|W|)) from each printed W, within the
     rounding of both printed numbers."""
@@ -62,14 +73,17 @@ def test_the_costa2000_design(costa):
     first_set = design.sets[0]
     reference = design.surfaces[first_set["reference"]]
     assert (reference["dimension"], reference["rq"]) == (1.275, 0.2781e-3)
-    grid = sorted((design.surfaces[n]["dimension"], round(design.surfaces[n]["rq"] * 1e3, 4)) for n in first_set["neighbours"])
+    grid = sorted(
+        (design.surfaces[n]["dimension"], round(design.surfaces[n]["rq"] * 1e3, 4)) for n in first_set["neighbours"]
+    )
     assert (1.35, 0.3502) in grid and len(grid) == 8 and (1.275, 0.2781) not in grid
     assert {d for d, _ in grid} == {1.2, 1.275, 1.35}
     assert design.surfaces[design.sets[1]["reference"]]["rq"] == 0.75e-3
     for subject in design.subjects:
         trials = design.trials_of(subject)
         assert sorted((t["set"], t["test"]) for t in trials) == sorted(
-            (s["id"], n) for s in design.sets for n in s["neighbours"])
+            (s["id"], n) for s in design.sets for n in s["neighbours"]
+        )
     orders = {tuple(t["test"] for t in design.trials_of(s)) for s in design.subjects}
     assert len(orders) == 14
     test_first = np.mean([t["first"] == t["test"] for t in design.trials])
@@ -80,8 +94,12 @@ def test_the_costa2000_design(costa):
 
 def test_the_same_seed_makes_the_same_study(tmp_path):
     surfaces, sets = grid_design([(1.3, 0.1e-3)], 0.05, 1.2)
-    first = write_study(tmp_path / "a", {k: dict(v) for k, v in surfaces.items()}, sets, ["a", "b"], 9, 5e-3, 30.9e-6, 0.1545e-3)
-    second = write_study(tmp_path / "b", {k: dict(v) for k, v in surfaces.items()}, sets, ["a", "b"], 9, 5e-3, 30.9e-6, 0.1545e-3)
+    first = write_study(
+        tmp_path / "a", {k: dict(v) for k, v in surfaces.items()}, sets, ["a", "b"], 9, 5e-3, 30.9e-6, 0.1545e-3
+    )
+    second = write_study(
+        tmp_path / "b", {k: dict(v) for k, v in surfaces.items()}, sets, ["a", "b"], 9, 5e-3, 30.9e-6, 0.1545e-3
+    )
     assert first.trials == second.trials
     from rough import read
 
@@ -112,8 +130,21 @@ def test_a_session_killed_mid_way_resumes_without_losing_or_repeating_a_trial(st
     reference = tmp_path / "reference"
     shutil.copytree(study, reference)
     rough("experiment", "run", reference, "--subject", "S05", "--observer", OBSERVER, check=True)
-    command = [sys.executable, "-m", "rough", "experiment", "run", str(study), "--subject", "S05", "--observer", OBSERVER,
-               "--realtime", "--stroke", "0.1s"]
+    command = [
+        sys.executable,
+        "-m",
+        "rough",
+        "experiment",
+        "run",
+        str(study),
+        "--subject",
+        "S05",
+        "--observer",
+        OBSERVER,
+        "--realtime",
+        "--stroke",
+        "0.1s",
+    ]
     session = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     path = study / "answers" / "S05.csv"
     deadline = time.monotonic() + 60
@@ -131,8 +162,9 @@ def test_a_session_killed_mid_way_resumes_without_losing_or_repeating_a_trial(st
     assert [int(r["trial"]) for r in after] == list(range(1, 17))
     assert after[: len(before)] == before
     drop = ("response_time_s", "finished")
-    assert [{k: v for k, v in r.items() if k not in drop} for r in after] == \
-           [{k: v for k, v in r.items() if k not in drop} for r in answers(reference, "S05")]
+    assert [{k: v for k, v in r.items() if k not in drop} for r in after] == [
+        {k: v for k, v in r.items() if k not in drop} for r in answers(reference, "S05")
+    ]
 
 
 # -- bad folders and files -----------------------------------------------------------------------
@@ -143,9 +175,13 @@ def test_bad_study_folders_and_answer_files_exit_2(study, tmp_path):
     empty.mkdir()
     assert_one_line_error(rough("experiment", "analyze", empty), "not a study folder")
     assert_one_line_error(rough("experiment", "analyze", study), "no answers yet")
-    assert_one_line_error(rough("experiment", "run", study, "--subject", "S99", "--observer", OBSERVER), "not in the study")
+    assert_one_line_error(
+        rough("experiment", "run", study, "--subject", "S99", "--observer", OBSERVER), "not in the study"
+    )
     assert_one_line_error(rough("experiment", "run", study, "--subject", "S01"), "--observer")
-    assert_one_line_error(rough("experiment", "run", study, "--subject", "S01", "--observer", "rq=fast"), "not a number")
+    assert_one_line_error(
+        rough("experiment", "run", study, "--subject", "S01", "--observer", "rq=fast"), "not a number"
+    )
     assert_one_line_error(rough("experiment", "design", "--preset", "costa2000", study), "not an empty folder")
     assert_one_line_error(rough("experiment", "design", tmp_path / "new"), "--preset costa2000 or")
     rough("experiment", "run", study, "--subject", "S01", "--observer", OBSERVER, check=True)
@@ -174,8 +210,13 @@ def test_a_missing_surface_is_named(study):
 
 # -- analysis ------------------------------------------------------------------------------------
 
-CELLS = [(i * 0.075, rq * (0.3502 / 0.2781) ** j - rq) for rq in (0.2781e-3, 0.75e-3)
-         for i in (-1, 0, 1) for j in (-1, 0, 1) if (i, j) != (0, 0)]
+CELLS = [
+    (i * 0.075, rq * (0.3502 / 0.2781) ** j - rq)
+    for rq in (0.2781e-3, 0.75e-3)
+    for i in (-1, 0, 1)
+    for j in (-1, 0, 1)
+    if (i, j) != (0, 0)
+]
 
 
 def simulated_table(observer, subjects, replicates):
@@ -200,7 +241,9 @@ def test_simulated_subjects_coefficients_are_recovered():
     estimates = []
     for seed in range(60):
         result = fit(simulated_table(Observer(rq=6.0, dimension=-5.0, spread=0.5, seed=seed), 14, 4))
-        estimates.append([result.coefficients[k][v] for k in ("rq", "fractal_dimension") for v in ("estimate", "stderr")])
+        estimates.append(
+            [result.coefficients[k][v] for k in ("rq", "fractal_dimension") for v in ("estimate", "stderr")]
+        )
     estimates = np.array(estimates)
     for column, truth in ((0, 6.0), (2, -5.0)):
         values, errors = estimates[:, column], estimates[:, column + 1]
@@ -212,8 +255,13 @@ def test_simulated_subjects_coefficients_are_recovered():
 def test_the_wald_test_keeps_its_false_positive_rate_for_a_null_effect():
     """300 studies of the paper's size (14 subjects × 16 pairs) in which D has no effect:
     the Wald test of D rejects at the 5 % level in 2–8.5 % of them (binomial 95 % range)."""
-    rejected = [fit(simulated_table(Observer(rq=6.0, dimension=0.0, spread=0.5, seed=seed), 14, 1))
-                .coefficients["fractal_dimension"]["p"] < 0.05 for seed in range(300)]
+    rejected = [
+        fit(simulated_table(Observer(rq=6.0, dimension=0.0, spread=0.5, seed=seed), 14, 1)).coefficients[
+            "fractal_dimension"
+        ]["p"]
+        < 0.05
+        for seed in range(300)
+    ]
     assert 0.02 <= np.mean(rejected) <= 0.085
 
 
@@ -225,9 +273,13 @@ def test_separation_is_flagged():
 def test_analyze_command(study, tmp_path):
     for subject in ("S01", "S02", "S03", "S04"):
         rough("experiment", "run", study, "--subject", subject, "--observer", OBSERVER, check=True)
-    document = json.loads(rough("experiment", "analyze", study, "--json", "--plot", tmp_path / "f.png", check=True).stdout)
+    document = json.loads(
+        rough("experiment", "analyze", study, "--json", "--plot", tmp_path / "f.png", check=True).stdout
+    )
     assert document["n"] == 64
-    assert {"fractal_dimension", "rq", "subject_S02", "subject_S03", "subject_S04", "constant"} == set(document["coefficients"])
+    assert {"fractal_dimension", "rq", "subject_S02", "subject_S03", "subject_S04", "constant"} == set(
+        document["coefficients"]
+    )
     assert set(document["coefficients"]["rq"]) >= {"estimate", "stderr", "wald", "p"}
     table = rough("experiment", "analyze", study, "--set", "1", check=True).stdout.decode()
     assert "fractal dimension D" in table and "Rq (per mm)" in table and "likelihood ratio" in table

@@ -17,8 +17,11 @@ BIG = ["synth", "--size", "4096x4096", "--spacing", "1um", "--dimension", "2.3",
 
 def start_writing(folder):
     """Start writing a 134 MB map to ``folder/big.x3p``; return once its temporary file has data."""
-    process = subprocess.Popen([sys.executable, "-m", "rough", *BIG, "-o", str(folder / "big.x3p")],
-                               stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    process = subprocess.Popen(
+        [sys.executable, "-m", "rough", *BIG, "-o", str(folder / "big.x3p")],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
     deadline = time.monotonic() + 60
     while time.monotonic() < deadline:
         partial = [p for p in folder.iterdir() if p.name.startswith(".rough-") and p.stat().st_size > 1 << 20]
@@ -53,8 +56,26 @@ def test_a_full_standard_output_is_a_clear_error():
     if not os.path.exists("/dev/full"):
         pytest.skip("no /dev/full on this system")
     with open("/dev/full", "wb") as full:
-        result = subprocess.run([sys.executable, "-m", "rough", "synth", "--length", "20mm", "--dimension", "1.3", "--rq",
-                                 "0.1mm", "-f", "tsv"], stdout=full, stderr=subprocess.PIPE, timeout=60, check=False)
+        result = subprocess.run(
+            [
+                sys.executable,
+                "-m",
+                "rough",
+                "synth",
+                "--length",
+                "20mm",
+                "--dimension",
+                "1.3",
+                "--rq",
+                "0.1mm",
+                "-f",
+                "tsv",
+            ],
+            stdout=full,
+            stderr=subprocess.PIPE,
+            timeout=60,
+            check=False,
+        )
     assert_one_line_error(result, "standard output: No space left on device", status=1)
 
 
@@ -65,15 +86,28 @@ def tiny_disk(tmp_path):
         pytest.skip("mounting a tiny tmpfs needs root")
     folder = tmp_path / "disk"
     folder.mkdir()
-    if subprocess.run([mount, "-t", "tmpfs", "-o", "size=64k", "tmpfs", str(folder)], capture_output=True, check=False).returncode:
+    if subprocess.run(
+        [mount, "-t", "tmpfs", "-o", "size=64k", "tmpfs", str(folder)], capture_output=True, check=False
+    ).returncode:
         pytest.skip("this system does not let tests mount a tmpfs")
     yield folder
     subprocess.run(["umount", str(folder)], check=False)
 
 
 def test_a_full_disk_is_a_clear_error_and_leaves_nothing(tiny_disk):
-    result = rough("synth", "--size", "256x256", "--spacing", "1um", "--dimension", "2.3", "--amplitude", "1um",
-                   "-o", tiny_disk / "map.x3p")
+    result = rough(
+        "synth",
+        "--size",
+        "256x256",
+        "--spacing",
+        "1um",
+        "--dimension",
+        "2.3",
+        "--amplitude",
+        "1um",
+        "-o",
+        tiny_disk / "map.x3p",
+    )
     assert_one_line_error(result, f"{tiny_disk / 'map.x3p'}: No space left on device", status=1)
     assert list(tiny_disk.iterdir()) == []
     plot = rough("synth", "--length", "5mm", "--dimension", "1.3", "--rq", "0.1mm", check=True).stdout

@@ -79,12 +79,15 @@ def test_x_y_z_grid_in_any_order_with_a_missing_point():
     assert surface.heights[2, 3] == 23.0
 
 
-@pytest.mark.parametrize("body,message", [
-    ("0 0 1\n0 0 2\n1 1 3\n1 0 4\n", "more than one height"),
-    ("0 0 1\n1 0 1\n2.6 0 1\n0 1 1\n", "not evenly spaced"),
-    ("x z\n", "no numeric data"),
-    ("1 2\n3 x\n", "unreadable number"),
-])
+@pytest.mark.parametrize(
+    "body,message",
+    [
+        ("0 0 1\n0 0 2\n1 1 3\n1 0 4\n", "more than one height"),
+        ("0 0 1\n1 0 1\n2.6 0 1\n0 1 1\n", "not evenly spaced"),
+        ("x z\n", "no numeric data"),
+        ("1 2\n3 x\n", "unreadable number"),
+    ],
+)
 def test_text_refusals(body, message):
     with pytest.raises(FormatError, match=message):
         text(body)
@@ -106,7 +109,10 @@ def test_plain_matrix_of_heights():
 
 @pytest.mark.parametrize("title", ["", "a", "ab", "abc"])  # every header length modulo 4
 def test_gsf_padding_and_units(title):
-    blob = gsf(["XRes = 3", "YRes = 2", "XReal = 3", "YReal = 4", "XYUnits = mm", "ZUnits = um", f"Title = {title}"], np.arange(6))
+    blob = gsf(
+        ["XRes = 3", "YRes = 2", "XReal = 3", "YReal = 4", "XYUnits = mm", "ZUnits = um", f"Title = {title}"],
+        np.arange(6),
+    )
     surface = read_bytes(blob)
     assert surface.spacing == pytest.approx((1e-3, 2e-3))
     np.testing.assert_allclose(surface.heights, np.arange(6.0).reshape(2, 3) * UM)
@@ -129,12 +135,15 @@ def test_gsf_one_row_is_a_profile():
     assert surface.is_profile and surface.spacing == pytest.approx((1e-6,))
 
 
-@pytest.mark.parametrize("lines,values,message", [
-    (["XRes = 3"], [1, 2, 3], "YRes"),
-    (["XRes = 3", "YRes = 2"], [1, 2, 3], "holds 12 bytes"),
-    (["XRes = 1000000", "YRes = 1000000"], [1], "declares 1000000×1000000"),
-    (["XRes = 2", "YRes = 1", "XReal = -1"], [1, 2], "positive"),
-])
+@pytest.mark.parametrize(
+    "lines,values,message",
+    [
+        (["XRes = 3"], [1, 2, 3], "YRes"),
+        (["XRes = 3", "YRes = 2"], [1, 2, 3], "holds 12 bytes"),
+        (["XRes = 1000000", "YRes = 1000000"], [1], "declares 1000000×1000000"),
+        (["XRes = 2", "YRes = 1", "XReal = -1"], [1, 2], "positive"),
+    ],
+)
 def test_gsf_refusals(lines, values, message):
     with pytest.raises(FormatError, match=message):
         read_bytes(gsf(lines, values))
@@ -196,13 +205,16 @@ def test_al3d_rows_padded_to_eight_bytes_and_invalid_points():
     assert surface.source_format == "al3d"
 
 
-@pytest.mark.parametrize("blob_options,message", [
-    ({"cut": 8}, "runs past the end"),
-    ({"tags": {"Cols": "abc"}}, "Cols is 'abc'"),
-    ({"tags": {"PixelSizeXMeter": "0"}}, "not a pixel size"),
-    ({"tags": {"DepthImageOffset": 0}}, "no depth image"),
-    ({"tags": {"DepthImageOffset": 10**9}}, "runs past the end"),
-])
+@pytest.mark.parametrize(
+    "blob_options,message",
+    [
+        ({"cut": 8}, "runs past the end"),
+        ({"tags": {"Cols": "abc"}}, "Cols is 'abc'"),
+        ({"tags": {"PixelSizeXMeter": "0"}}, "not a pixel size"),
+        ({"tags": {"DepthImageOffset": 0}}, "no depth image"),
+        ({"tags": {"DepthImageOffset": 10**9}}, "runs past the end"),
+    ],
+)
 def test_al3d_refusals(blob_options, message):
     with pytest.raises(FormatError, match=message):
         read_bytes(al3d_file(np.ones((4, 6), np.float32), **blob_options))
@@ -227,15 +239,18 @@ def test_gzipped_input(tmp_path):
 # -- third-party files: the sizes data/INDEX.md lists ---------------------------------------
 
 
-@pytest.mark.parametrize("name,points,size", [
-    ("matrix-3.txt", (256, 256), (10e-6, 10e-6)),
-    ("matrix-4.txt.gz", (75, 305), (2.773965e-05, 1.1280791e-04)),
-    ("hfm-1.hfm", (9600,), (4.8e-3,)),
-    ("dektak-1.csv", (9600,), (1500e-6,)),
-    ("sdf-1.sdf", (7, 4), (7e-6, 4e-6)),
-    ("xyz-1.txt", (4, 4), (4.0, 4.0)),
-    ("gwyddion-export-english.txt", (3, 4), (12.34e-6, 5678.9e-9)),
-])
+@pytest.mark.parametrize(
+    "name,points,size",
+    [
+        ("matrix-3.txt", (256, 256), (10e-6, 10e-6)),
+        ("matrix-4.txt.gz", (75, 305), (2.773965e-05, 1.1280791e-04)),
+        ("hfm-1.hfm", (9600,), (4.8e-3,)),
+        ("dektak-1.csv", (9600,), (1500e-6,)),
+        ("sdf-1.sdf", (7, 4), (7e-6, 4e-6)),
+        ("xyz-1.txt", (4, 4), (4.0, 4.0)),
+        ("gwyddion-export-english.txt", (3, 4), (12.34e-6, 5678.9e-9)),
+    ],
+)
 def test_third_party_text_files(shared_data, name, points, size):
     surface = read(shared_data / "SurfaceTopography" / name)
     assert surface.points == points
@@ -245,8 +260,12 @@ def test_third_party_text_files(shared_data, name, points, size):
 def test_matrix3_and_matrix4_heights(shared_data):
     from rough.summary import summary
 
-    assert summary(read(shared_data / "SurfaceTopography/matrix-3.txt"))["Sq"] == pytest.approx(3.5222918750198742e-08, rel=1e-12)
-    assert summary(read(shared_data / "SurfaceTopography/matrix-4.txt.gz"))["Sq"] == pytest.approx(1.1745891510991089e-07, rel=1e-12)
+    assert summary(read(shared_data / "SurfaceTopography/matrix-3.txt"))["Sq"] == pytest.approx(
+        3.5222918750198742e-08, rel=1e-12
+    )
+    assert summary(read(shared_data / "SurfaceTopography/matrix-4.txt.gz"))["Sq"] == pytest.approx(
+        1.1745891510991089e-07, rel=1e-12
+    )
 
 
 def test_hfm_line_scan_rms(shared_data):
@@ -298,8 +317,11 @@ def test_exr_in_gwyddion_units_and_scale():
 
     header = {
         "type": OpenEXR.scanlineimage,
-        "Gwy::XReal": np.array([30.0]), "Gwy::YReal": np.array([20.0]),
-        "Gwy::XYUnit": "µm", "Gwy::ZUnit": "nm", "Gwy::ZScale": np.array([2.0]),
+        "Gwy::XReal": np.array([30.0]),
+        "Gwy::YReal": np.array([20.0]),
+        "Gwy::XYUnit": "µm",
+        "Gwy::ZUnit": "nm",
+        "Gwy::ZScale": np.array([2.0]),
     }
     buffer = io.BytesIO()
     OpenEXR.File(header, {"Y": np.ones((2, 3), "f4")}).write(buffer)

@@ -63,7 +63,9 @@ def test_rq_is_exact_and_the_seed_reproduces_bits():
     assert a.heights.tobytes() == b.heights.tobytes() and a.heights.shape == (200, 300)
     assert math.sqrt(np.mean((a.heights - a.heights.mean()) ** 2)) == pytest.approx(1e-6, rel=1e-9)
     entry = first.history[-1]
-    assert entry["command"] == "synth" and entry["parameters"]["seed"] == 42 and entry["parameters"]["dimension"] == 1.275
+    assert (
+        entry["command"] == "synth" and entry["parameters"]["seed"] == 42 and entry["parameters"]["dimension"] == 1.275
+    )
 
 
 def test_seed_is_recorded_when_not_given():
@@ -85,7 +87,10 @@ def test_synth_then_fit_recovers_d_and_c_of_profiles(dimension):
 
 @pytest.mark.parametrize("dimension", [2.2, 2.5, 2.8])
 def test_synth_then_fit_recovers_ds_and_c_of_maps(dimension):
-    fits = [fit_fractal(synthesize_map((256, 256), (1e-6, 1e-6), dimension, amplitude=3e-6, seed=900 + s)) for s in range(20)]
+    fits = [
+        fit_fractal(synthesize_map((256, 256), (1e-6, 1e-6), dimension, amplitude=3e-6, seed=900 + s))
+        for s in range(20)
+    ]
     estimates = np.array([f.fractal_dimension for f in fits])
     amplitudes = np.array([f.amplitude_coefficient for f in fits])
     assert abs(estimates.mean() - dimension) < 3 * estimates.std() / math.sqrt(20) + 1e-3
@@ -102,9 +107,13 @@ def test_profiles_through_a_map_share_its_amplitude_coefficient():
     per_map = []
     for seed in range(24):
         surface = synthesize_map((1024, 1024), (1e-6, 1e-6), 2.4, amplitude=3e-6, seed=11 + seed)
-        rows = [fit_fractal(Surface(row, (1e-6,)), band=(None, 0.1 / 1e-6), resolution=eta, sampling="band-limited")
-                for row in surface.heights[::128]]
-        per_map.append((np.mean([r.fractal_dimension for r in rows]), np.mean([r.amplitude_coefficient for r in rows]) / expected))
+        rows = [
+            fit_fractal(Surface(row, (1e-6,)), band=(None, 0.1 / 1e-6), resolution=eta, sampling="band-limited")
+            for row in surface.heights[::128]
+        ]
+        per_map.append(
+            (np.mean([r.fractal_dimension for r in rows]), np.mean([r.amplitude_coefficient for r in rows]) / expected)
+        )
     dimensions, ratios = np.array(per_map).T
     assert dimensions.mean() == pytest.approx(1.4, abs=0.01)
     assert abs(ratios.mean() - 1.0) < 3 * ratios.std() / math.sqrt(len(ratios)) + 0.01
@@ -164,7 +173,9 @@ def test_estimator_on_exact_fbm_is_unbiased_and_efficient(dimension):
 def test_cross_check_methods_on_exact_fbm():
     rng = np.random.default_rng(5)
     for method in ("variogram", "madogram"):
-        estimates = [fit_fractal(Surface(fbm(4096, 0.6, rng), (1.0,)), method=method).fractal_dimension for _ in range(60)]
+        estimates = [
+            fit_fractal(Surface(fbm(4096, 0.6, rng), (1.0,)), method=method).fractal_dimension for _ in range(60)
+        ]
         assert np.mean(estimates) == pytest.approx(1.4, abs=0.01), method
 
 
@@ -192,8 +203,12 @@ def resampling_errors(factor, coarsen):
         surface = synthesize_profile(n, dx, 1.3, amplitude=1e-6, seed=7000 + seed)
         before = fit_fractal(surface, band=band, resolution=8e-6)
         after = fit_fractal(coarsen(surface, factor), band=band, resolution=8e-6)
-        changes.append((after.fractal_dimension / before.fractal_dimension - 1,
-                        after.amplitude_coefficient / before.amplitude_coefficient - 1))
+        changes.append(
+            (
+                after.fractal_dimension / before.fractal_dimension - 1,
+                after.amplitude_coefficient / before.amplitude_coefficient - 1,
+            )
+        )
     return np.mean(changes, axis=0)
 
 
@@ -243,7 +258,9 @@ def test_paper_fragments_fall_short_of_eq2_and_whole_length_does_not():
         return float(np.sqrt(np.mean((surface.heights - surface.heights.mean()) ** 2)))
 
     whole = np.mean([rq(synthesize_profile(n, spacing, dimension, amplitude=amplitude, seed=s)) for s in range(200)])
-    fragments = np.mean([rq(synthesize_fragments(n, spacing, dimension, amplitude=amplitude, seed=s)) for s in range(200)])
+    fragments = np.mean(
+        [rq(synthesize_fragments(n, spacing, dimension, amplitude=amplitude, seed=s)) for s in range(200)]
+    )
     f = np.arange(1, n // 2 + 1) / (n * spacing)
     g = model.prefactor(amplitude, dimension, spacing) * f ** -(5 - 2 * dimension)
     theory = math.sqrt((g[:-1].sum() + g[-1] / 2) / (n * spacing)) / target
@@ -292,7 +309,9 @@ def test_map_constant_relates_map_and_profile_spectra():
     assert 2 * integral == pytest.approx(expected, rel=1e-4)
 
 
-@pytest.mark.parametrize("value,profile,hint", [(2.3, True, "Ds = D + 1"), (1.3, False, "D = Ds - 1"), (0.5, True, "between 1 and 2")])
+@pytest.mark.parametrize(
+    "value,profile,hint", [(2.3, True, "Ds = D + 1"), (1.3, False, "D = Ds - 1"), (0.5, True, "between 1 and 2")]
+)
 def test_dimension_out_of_range_is_refused_with_a_hint(value, profile, hint):
     with pytest.raises(InputError, match=re.escape(hint)):
         model.check_dimension(value, profile)

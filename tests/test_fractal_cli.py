@@ -6,8 +6,18 @@ import pytest
 
 from conftest import assert_one_line_error, rough
 
-FIT_KEYS = {"fractal_dimension", "fractal_dimension_stderr", "amplitude_coefficient", "resolution", "psd_prefactor",
-            "hurst", "band", "method", "window", "sampling"}
+FIT_KEYS = {
+    "fractal_dimension",
+    "fractal_dimension_stderr",
+    "amplitude_coefficient",
+    "resolution",
+    "psd_prefactor",
+    "hurst",
+    "band",
+    "method",
+    "window",
+    "sampling",
+}
 
 
 def fit_json(*args, input=None):
@@ -15,7 +25,9 @@ def fit_json(*args, input=None):
 
 
 def test_synth_profile_then_fit():
-    profile = rough("synth", "--length", "40mm", "--dimension", "1.35", "--rq", "0.3mm", "--seed", "4", check=True).stdout
+    profile = rough(
+        "synth", "--length", "40mm", "--dimension", "1.35", "--rq", "0.3mm", "--seed", "4", check=True
+    ).stdout
     values = fit_json(input=profile)
     assert FIT_KEYS <= set(values)
     assert values["fractal_dimension"] == pytest.approx(1.35, abs=4 * values["fractal_dimension_stderr"])
@@ -28,7 +40,20 @@ def test_synth_profile_then_fit():
 
 
 def test_synth_map_then_fit_reports_the_surface_dimension():
-    surface = rough("synth", "--size", "256x256", "--spacing", "10um", "--dimension", "2.3", "--amplitude", "1um", "--seed", "2", check=True).stdout
+    surface = rough(
+        "synth",
+        "--size",
+        "256x256",
+        "--spacing",
+        "10um",
+        "--dimension",
+        "2.3",
+        "--amplitude",
+        "1um",
+        "--seed",
+        "2",
+        check=True,
+    ).stdout
     values = fit_json(input=surface)
     assert values["fractal_dimension"] == pytest.approx(2.3, abs=0.03)
     assert values["profile_dimension"] == pytest.approx(values["fractal_dimension"] - 1)
@@ -38,24 +63,64 @@ def test_synth_map_then_fit_reports_the_surface_dimension():
 def test_seed_gives_identical_files(tmp_path):
     env = {"SOURCE_DATE_EPOCH": "1767225600"}
     for name in ("a", "b"):
-        rough("synth", "--length", "5mm", "--dimension", "1.4", "--amplitude", "2um", "--seed", "9", "-o", tmp_path / f"{name}.x3p", env=env, check=True)
+        rough(
+            "synth",
+            "--length",
+            "5mm",
+            "--dimension",
+            "1.4",
+            "--amplitude",
+            "2um",
+            "--seed",
+            "9",
+            "-o",
+            tmp_path / f"{name}.x3p",
+            env=env,
+            check=True,
+        )
     assert (tmp_path / "a.x3p").read_bytes() == (tmp_path / "b.x3p").read_bytes()
 
 
 def test_anisotropic_map_from_the_command_line():
-    surface = rough("synth", "--size", "256x256", "--spacing", "10um", "--anisotropy", "2.2,1um,2.5,3um,30", "--seed", "1", check=True).stdout
+    surface = rough(
+        "synth",
+        "--size",
+        "256x256",
+        "--spacing",
+        "10um",
+        "--anisotropy",
+        "2.2,1um,2.5,3um,30",
+        "--seed",
+        "1",
+        check=True,
+    ).stdout
     facts = json.loads(rough("info", "--json", input=surface, check=True).stdout)
     assert facts["history"][-1]["parameters"]["anisotropy"] == [2.2, 1e-6, 2.5, 3e-6, pytest.approx(30.0)]
 
 
 def test_fragments_warn(tmp_path):
-    result = rough("synth", "--length", "10mm", "--dimension", "1.275", "--amplitude", "1um", "--fragments", "--seed", "1", "-o", tmp_path / "f.x3p")
+    result = rough(
+        "synth",
+        "--length",
+        "10mm",
+        "--dimension",
+        "1.275",
+        "--amplitude",
+        "1um",
+        "--fragments",
+        "--seed",
+        "1",
+        "-o",
+        tmp_path / "f.x3p",
+    )
     assert result.returncode == 0
     assert b"drop every wavelength longer than a fragment" in result.stderr
 
 
 def test_fit_outputs_spectrum_and_plot(tmp_path):
-    surface = rough("synth", "--length", "20mm", "--dimension", "1.3", "--rq", "0.2mm", "--seed", "3", check=True).stdout
+    surface = rough(
+        "synth", "--length", "20mm", "--dimension", "1.3", "--rq", "0.2mm", "--seed", "3", check=True
+    ).stdout
     fit_json("--psd", tmp_path / "psd.tsv", "--plot", tmp_path / "psd.png", input=surface)
     lines = (tmp_path / "psd.tsv").read_text().splitlines()
     assert lines[1] == "frequency_per_m\tdensity_m3\tcount" and len(lines) > 10
@@ -63,7 +128,9 @@ def test_fit_outputs_spectrum_and_plot(tmp_path):
 
 
 def test_band_and_methods():
-    surface = rough("synth", "--length", "40mm", "--dimension", "1.3", "--rq", "0.2mm", "--seed", "5", check=True).stdout
+    surface = rough(
+        "synth", "--length", "40mm", "--dimension", "1.3", "--rq", "0.2mm", "--seed", "5", check=True
+    ).stdout
     banded = fit_json("--band", "0.1/mm:5/mm", input=surface)
     assert banded["band"][0] >= 100 and banded["band"][1] <= 5000
     assert fit_json("--method", "variogram", input=surface)["method"] == "variogram"
@@ -71,20 +138,36 @@ def test_band_and_methods():
 
 
 def test_resample_command():
-    surface = rough("synth", "--length", "10mm", "--spacing", "0.0309mm", "--dimension", "1.3", "--rq", "0.1mm", "--seed", "1", check=True).stdout
+    surface = rough(
+        "synth",
+        "--length",
+        "10mm",
+        "--spacing",
+        "0.0309mm",
+        "--dimension",
+        "1.3",
+        "--rq",
+        "0.1mm",
+        "--seed",
+        "1",
+        check=True,
+    ).stdout
     coarse = rough("resample", "--spacing", "0.1545mm", input=surface, check=True).stdout
     facts = json.loads(rough("info", "--json", input=coarse, check=True).stdout)
     assert facts["spacing"] == [pytest.approx(0.1545e-3)]
     assert [entry["command"] for entry in facts["history"]] == ["synth", "resample"]
 
 
-@pytest.mark.parametrize("args,message", [
-    (["synth", "--length", "10mm", "--dimension", "2.3", "--rq", "1um"], "Ds = D + 1"),
-    (["synth", "--size", "64x64", "--dimension", "1.3", "--rq", "1um"], "D = Ds - 1"),
-    (["synth", "--length", "10mm", "--dimension", "1.3"], "--amplitude"),
-    (["synth", "--dimension", "1.3", "--rq", "1um"], "--length"),
-    (["synth", "--size", "64", "--dimension", "2.3", "--rq", "1um"], "NXxNY"),
-])
+@pytest.mark.parametrize(
+    "args,message",
+    [
+        (["synth", "--length", "10mm", "--dimension", "2.3", "--rq", "1um"], "Ds = D + 1"),
+        (["synth", "--size", "64x64", "--dimension", "1.3", "--rq", "1um"], "D = Ds - 1"),
+        (["synth", "--length", "10mm", "--dimension", "1.3"], "--amplitude"),
+        (["synth", "--dimension", "1.3", "--rq", "1um"], "--length"),
+        (["synth", "--size", "64", "--dimension", "2.3", "--rq", "1um"], "NXxNY"),
+    ],
+)
 def test_synth_refusals(args, message):
     assert_one_line_error(rough(*args), message)
 
@@ -99,5 +182,7 @@ def test_fit_refusals(tmp_path):
     Surface(heights, (1e-6,)).write(tmp_path / "gap.x3p")
     assert_one_line_error(rough("fit-fractal", tmp_path / "gap.x3p"), "--fill")
     assert rough("fit-fractal", "--fill", tmp_path / "gap.x3p").returncode == 0
-    assert_one_line_error(rough("fit-fractal", "--band", "1/mm:1.001/mm", tmp_path / "gap.x3p", "--fill"), "frequencies in the fit band")
+    assert_one_line_error(
+        rough("fit-fractal", "--band", "1/mm:1.001/mm", tmp_path / "gap.x3p", "--fill"), "frequencies in the fit band"
+    )
     assert_one_line_error(rough("fit-fractal", "--band", "fast", tmp_path / "gap.x3p"), "FMIN:FMAX")

@@ -11,7 +11,9 @@ import pytest
 from rough import Surface
 
 gwyfile = pytest.importorskip("gwyfile")
-pytestmark = pytest.mark.skipif(shutil.which("gwyddion") is None, reason="Gwyddion is not installed (apt-get install gwyddion)")
+pytestmark = pytest.mark.skipif(
+    shutil.which("gwyddion") is None, reason="Gwyddion is not installed (apt-get install gwyddion)"
+)
 
 IDENTIFIED = {"x3p": "ISO 5436-2 OpenGPS data (.x3p)", "gsf": "Gwyddion Simple Field (.gsf)"}
 

@@ -28,8 +28,9 @@ def guest():
             pytest.skip("qemu-system-x86 is not installed (.ci/run installs it)")
         if os.geteuid() != 0 or shutil.which("apt-get") is None:
             pytest.skip("building the guest needs root and apt-get (Debian's kernel and busybox packages)")
-        built = subprocess.run(["bash", str(recipe / "build.sh"), str(folder)], capture_output=True, text=True,
-                               timeout=1200, check=False)
+        built = subprocess.run(
+            ["bash", str(recipe / "build.sh"), str(folder)], capture_output=True, text=True, timeout=1200, check=False
+        )
         if built.returncode != 0 or not (folder / "initrd.img").exists():
             reason = (built.stderr or built.stdout).strip().splitlines()[-1:] or ["no output"]
             pytest.skip(f"the guest could not be built: {reason[0]}")
@@ -39,9 +40,16 @@ def guest():
 @pytest.fixture(scope="module")
 def outcome(guest):
     recipe, folder = guest
-    console = subprocess.run(["bash", str(recipe / "run.sh"), str(folder), sys.executable, str(ROOT / "tests" / "vhid_guest.py")],
-                             capture_output=True, text=True, timeout=900, check=False)
-    lines = [line[line.index("RESULT {") + len("RESULT "):] for line in console.stdout.splitlines() if "RESULT {" in line]
+    console = subprocess.run(
+        ["bash", str(recipe / "run.sh"), str(folder), sys.executable, str(ROOT / "tests" / "vhid_guest.py")],
+        capture_output=True,
+        text=True,
+        timeout=900,
+        check=False,
+    )
+    lines = [
+        line[line.index("RESULT {") + len("RESULT ") :] for line in console.stdout.splitlines() if "RESULT {" in line
+    ]
     assert lines, f"the guest printed no result:\n{console.stdout[-3000:]}\n{console.stderr[-2000:]}"
     return json.loads(lines[-1])
 

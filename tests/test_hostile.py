@@ -28,9 +28,14 @@ def _refusal(row, folder):
     path = HOSTILE / row["file"]
     output = folder / f"{row['file']}.out.x3p"
     started = time.monotonic()
-    result = subprocess.run([sys.executable, "-m", "rough", "convert", str(path), "-o", str(output)],
-                            capture_output=True, timeout=60, preexec_fn=_limited, check=False,
-                            env={**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"})
+    result = subprocess.run(
+        [sys.executable, "-m", "rough", "convert", str(path), "-o", str(output)],
+        capture_output=True,
+        timeout=60,
+        preexec_fn=_limited,
+        check=False,
+        env={**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"},
+    )
     elapsed = time.monotonic() - started
     stderr = result.stderr.decode(errors="replace")
     problems = []
@@ -67,8 +72,18 @@ def test_every_hostile_file_is_refused_cleanly(tmp_path):
     assert peak < ADDRESS_SPACE // 2, f"a reader used {peak >> 20} MB"
 
 
-@pytest.mark.parametrize("name", ["x3p-zip-bomb.x3p", "x3p-member-size-lie.x3p", "gzip-bomb.txt.gz", "x3p-entity-bomb.x3p",
-                                  "gsf-absurd-size.gsf", "npy-absurd-shape.npy", "al3d-absurd-size.al3d"])
+@pytest.mark.parametrize(
+    "name",
+    [
+        "x3p-zip-bomb.x3p",
+        "x3p-member-size-lie.x3p",
+        "gzip-bomb.txt.gz",
+        "x3p-entity-bomb.x3p",
+        "gsf-absurd-size.gsf",
+        "npy-absurd-shape.npy",
+        "al3d-absurd-size.al3d",
+    ],
+)
 def test_bombs_and_absurd_sizes_are_refused_before_allocation(name):
     """In-process, with tracemalloc: refusing costs little more than the file itself."""
     import tracemalloc

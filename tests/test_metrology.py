@@ -72,8 +72,10 @@ def test_polynomials_up_to_the_order_are_removed_to_rounding(order):
 def test_map_polynomials_of_total_degree_are_removed(order):
     y, x = np.mgrid[0:90, 0:130] * 1e-6
     rng = np.random.default_rng(order)
-    heights = sum(rng.normal() * (x / 1e-4) ** i * (y / 1e-4) ** j
-                  for i in range(order + 1) for j in range(order + 1 - i)) * 1e-6
+    heights = (
+        sum(rng.normal() * (x / 1e-4) ** i * (y / 1e-4) ** j for i in range(order + 1) for j in range(order + 1 - i))
+        * 1e-6
+    )
     heights[30:40, 50:70] = np.nan
     residual = detrend(Surface(heights, (1e-6, 1e-6)), order=order).heights
     assert np.nanmax(np.abs(residual)) <= 1e-11 * np.nanmax(np.abs(heights))
@@ -141,8 +143,17 @@ def test_surfalize_profile_fixture():
     x = np.arange(1000)
     data = np.sin(x / 50 * 2 * np.pi) + np.random.normal(size=1000) * 0.1
     values = profile_parameters(Surface(data, (0.1,)))
-    expected = {"Ra": 0.638341, "Rq": 0.713584, "Rp": 1.146977, "Rv": 1.179609, "Rz": 2.326586, "Rt": 2.479203,
-                "Rsk": -0.002984, "Rku": 1.564224, "Rdq": 1.667171}
+    expected = {
+        "Ra": 0.638341,
+        "Rq": 0.713584,
+        "Rp": 1.146977,
+        "Rv": 1.179609,
+        "Rz": 2.326586,
+        "Rt": 2.479203,
+        "Rsk": -0.002984,
+        "Rku": 1.564224,
+        "Rdq": 1.667171,
+    }
     for key, value in expected.items():
         assert values[key] == pytest.approx(value, abs=1e-6), key
 
@@ -154,8 +165,15 @@ def test_surfalize_surface_fixture():
     z += 0.5 * (np.sin((x - 200 / 2) / 200 * 2 * np.pi) + 1) * 0.3 * np.sin((np.sin(y / 10) + x) / 10 * 2 * np.pi)
     z += np.random.normal(size=z.shape) / 5
     values = areal_parameters(Surface(z, (0.1, 0.1)))
-    expected = {"Sa": 0.653132, "Sq": 0.745961, "Sp": 1.854956, "Sv": 1.998661, "Sz": 3.853617,
-                "Ssk": -0.08144, "Sku": 1.818014}
+    expected = {
+        "Sa": 0.653132,
+        "Sq": 0.745961,
+        "Sp": 1.854956,
+        "Sv": 1.998661,
+        "Sz": 3.853617,
+        "Ssk": -0.08144,
+        "Sku": 1.818014,
+    }
     for key, value in expected.items():
         assert values[key] == pytest.approx(value, abs=1e-6), key
     # Differences explained in the README: surfalize's gradient scheme, and its Str
@@ -166,11 +184,14 @@ def test_surfalize_surface_fixture():
     assert np.isnan(values["Str"])
 
 
-@pytest.mark.parametrize("name,expected", [
-    ("x3p-2.x3p", 0.062070073998443276),
-    ("matrix-3.txt", 0.19235602282848963),
-    ("matrix-4.txt.gz", 0.06776316911544318),
-])
+@pytest.mark.parametrize(
+    "name,expected",
+    [
+        ("x3p-2.x3p", 0.062070073998443276),
+        ("matrix-3.txt", 0.19235602282848963),
+        ("matrix-4.txt.gz", 0.06776316911544318),
+    ],
+)
 def test_sdq_is_surfacetopography_rms_gradient(shared_data, name, expected):
     from rough.io import read
 
@@ -178,11 +199,14 @@ def test_sdq_is_surfacetopography_rms_gradient(shared_data, name, expected):
     assert values["Sdq"] == pytest.approx(expected, rel=1e-12)
 
 
-@pytest.mark.parametrize("name,sq", [
-    ("x3p-2.x3p", 7.728033273597876e-08),
-    ("matrix-3.txt", 3.5222918750198742e-08),
-    ("matrix-4.txt.gz", 1.1745891510991089e-07),
-])
+@pytest.mark.parametrize(
+    "name,sq",
+    [
+        ("x3p-2.x3p", 7.728033273597876e-08),
+        ("matrix-3.txt", 3.5222918750198742e-08),
+        ("matrix-4.txt.gz", 1.1745891510991089e-07),
+    ],
+)
 def test_sq_matches_surfacetopography(shared_data, name, sq):
     from rough.io import read
 

@@ -18,7 +18,9 @@ MAP_KEYS = {"Sa", "Sq", "Ssk", "Sku", "Sp", "Sv", "Sz", "Sdq", "Sal", "Str", "St
 @pytest.fixture
 def rock(tmp_path):
     x = np.arange(6000) * 10e-6
-    heights = 3e-4 * x + 40e-6 * np.sin(2 * np.pi * x / 7e-3) + np.cumsum(np.random.default_rng(8).normal(size=x.size)) * 2e-7
+    heights = (
+        3e-4 * x + 40e-6 * np.sin(2 * np.pi * x / 7e-3) + np.cumsum(np.random.default_rng(8).normal(size=x.size)) * 2e-7
+    )
     path = tmp_path / "rock.x3p"
     Surface(heights, (10e-6,)).write(path)
     return path
@@ -40,7 +42,9 @@ def features_json(*args, input=None):
 def test_dektak_instrument_results_to_the_printed_digits(shared_data):
     """The Dektak's own Analytical Results for 468–733 µm: Ra 0.00525 µm, Rq 0.01143 µm,
     Skew 6.96, RzDin 0.04917 µm (levelled by a least-squares line over the region)."""
-    levelled = rough("detrend", "--order", "1", "--crop", "468um:733um", shared_data / "SurfaceTopography/dektak-1.csv", check=True)
+    levelled = rough(
+        "detrend", "--order", "1", "--crop", "468um:733um", shared_data / "SurfaceTopography/dektak-1.csv", check=True
+    )
     values = features_json(input=levelled.stdout)
     assert round(values["Ra"] * 1e6, 5) == 0.00525
     assert round(values["Rq"] * 1e6, 5) == 0.01143
@@ -108,7 +112,10 @@ def test_detrend_outputs(rock, tmp_path):
     for keep in ("roughness", "waviness", "form"):
         extra = ["--cutoff", "1mm"] if keep != "form" else []
         rough("detrend", "--keep", keep, *extra, rock, "-o", tmp_path / f"{keep}.x3p", check=True)
-    facts = {keep: json.loads(rough("info", "--json", tmp_path / f"{keep}.x3p", check=True).stdout) for keep in ("roughness", "waviness", "form")}
+    facts = {
+        keep: json.loads(rough("info", "--json", tmp_path / f"{keep}.x3p", check=True).stdout)
+        for keep in ("roughness", "waviness", "form")
+    }
     assert facts["roughness"]["shape"] == facts["waviness"]["shape"] == [5900]
     assert facts["form"]["shape"] == [6000]
     assert [entry["command"] for entry in facts["roughness"]["history"]] == ["detrend", "filter"]
@@ -125,12 +132,15 @@ def test_pipeline_detrend_to_features(rock):
     assert abs(values["Rsk"]) < 5
 
 
-@pytest.mark.parametrize("args,message", [
-    (["features", "--cutoff", "0.2mm"], "longer than the data"),
-    (["detrend", "--order", "9"], "order 9"),
-    (["features", "--crop", "1mm"], "write a range as X0:X1"),
-    (["features", "--crop", "0:1mm,0:1mm"], "a profile has no y range"),
-])
+@pytest.mark.parametrize(
+    "args,message",
+    [
+        (["features", "--cutoff", "0.2mm"], "longer than the data"),
+        (["detrend", "--order", "9"], "order 9"),
+        (["features", "--crop", "1mm"], "write a range as X0:X1"),
+        (["features", "--crop", "0:1mm,0:1mm"], "a profile has no y range"),
+    ],
+)
 def test_refusals(tmp_path, args, message):
     Surface(np.linspace(0, 1e-6, 8), (10e-6,)).write(tmp_path / "short.x3p")
     assert_one_line_error(rough(*args, tmp_path / "short.x3p"), message)

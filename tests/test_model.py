@@ -11,10 +11,21 @@ from rough.surface import history_entry
 from rough.units import format_length, metres_per, parse_length
 
 
-@pytest.mark.parametrize("text,metres", [
-    ("0.1545mm", 1.545e-4), ("30.9um", 30.9e-6), ("30.9 µm", 30.9e-6), ("30.9μm", 30.9e-6),
-    ("2e-3m", 2e-3), ("80", 80e-3), ("1.5nm", 1.5e-9), ("3km", 3e3), ("-2mm", -2e-3), (".5mm", 0.5e-3),
-])
+@pytest.mark.parametrize(
+    "text,metres",
+    [
+        ("0.1545mm", 1.545e-4),
+        ("30.9um", 30.9e-6),
+        ("30.9 µm", 30.9e-6),
+        ("30.9μm", 30.9e-6),
+        ("2e-3m", 2e-3),
+        ("80", 80e-3),
+        ("1.5nm", 1.5e-9),
+        ("3km", 3e3),
+        ("-2mm", -2e-3),
+        (".5mm", 0.5e-3),
+    ],
+)
 def test_parse_length(text, metres):
     assert parse_length(text) == pytest.approx(metres, rel=1e-15)
 
@@ -66,7 +77,9 @@ def test_derive_appends_history_and_keeps_the_original(monkeypatch):
     original = Surface(np.zeros(4), (1e-6,), metadata={"title": "a"})
     derived = original.derive("detrend", {"order": 2}, heights=np.ones(4))
     assert original.history == [] and original.heights.sum() == 0
-    assert derived.history == [{"command": "detrend", "parameters": {"order": 2}, "version": "0.1.0", "time": "2023-11-14T22:13:20Z"}]
+    assert derived.history == [
+        {"command": "detrend", "parameters": {"order": 2}, "version": "0.1.0", "time": "2023-11-14T22:13:20Z"}
+    ]
     derived.metadata["title"] = "b"
     assert original.metadata["title"] == "a"
 

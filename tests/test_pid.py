@@ -13,14 +13,32 @@ from rough.render import QuasiStatic, Settings, Track, run
 from rough.render.hid import DeviceGone, Joystick
 from rough.render.pid import MAGNITUDE, PidDescriptor, PidError
 
-SMALL = Layout(axis_bits=10, axis_range=(0, 1023), buttons=4, magnitude_bits=8, magnitude_range=(-127, 127),
-               max_effects=15,
-               ids={"input": 4, "state": 9, "set_effect": 2, "constant": 3, "operation": 6, "free": 7, "control": 8,
-                    "gain": 10, "create": 5, "load": 6, "pool": 7})
+SMALL = Layout(
+    axis_bits=10,
+    axis_range=(0, 1023),
+    buttons=4,
+    magnitude_bits=8,
+    magnitude_range=(-127, 127),
+    max_effects=15,
+    ids={
+        "input": 4,
+        "state": 9,
+        "set_effect": 2,
+        "constant": 3,
+        "operation": 6,
+        "free": 7,
+        "control": 8,
+        "gain": 10,
+        "create": 5,
+        "load": 6,
+        "pool": 7,
+    },
+)
 LAYOUTS = [Layout(), SMALL]
 PLAIN_JOYSTICK = bytes.fromhex(  # X, Y and buttons, a vendor output report: no PID page
     "05 01 09 04 a1 01 85 01 09 30 09 31 16 01 80 26 ff 7f 75 10 95 02 81 02"
-    "05 09 19 01 29 08 15 00 25 01 75 01 95 08 81 02 06 00 ff 85 02 09 01 16 01 80 26 ff 7f 75 10 95 02 91 02 c0")
+    "05 09 19 01 29 08 15 00 25 01 75 01 95 08 81 02 06 00 ff 85 02 09 01 16 01 80 26 ff 7f 75 10 95 02 91 02 c0"
+)
 
 
 @pytest.mark.parametrize("layout", LAYOUTS, ids=["16-bit", "8-bit"])
@@ -104,7 +122,16 @@ def test_closing_zeroes_stops_frees_and_disables():
     stick.write(3.0, 3.0)
     stick.close()
     assert device.force() == (0.0, 0.0) and device.effects == {} and not device.actuators and handle.closed
-    assert device.names()[-8:] == ["constant", "operation", "constant", "operation", "free", "free", "control", "control"]
+    assert device.names()[-8:] == [
+        "constant",
+        "operation",
+        "constant",
+        "operation",
+        "free",
+        "free",
+        "control",
+        "control",
+    ]
 
 
 def test_emergency_stop_silences_later_writes():
@@ -140,7 +167,9 @@ def test_a_whole_session_streams_the_model_and_switches_on_the_trigger():
     device, handle, stick = joystick(x=0.1, y=0.2, buttons=0)
     for k in range(40):
         handle.schedule(k * 1e-3, x=0.1 + 0.02 * k, buttons=1 if 20 <= k < 23 else 0)
-    result = run(stick, [first, second], QuasiStatic(), None, Settings(duration=0.04, ramp=0.0, realtime=True, watchdog=1.0))
+    result = run(
+        stick, [first, second], QuasiStatic(), None, Settings(duration=0.04, ramp=0.0, realtime=True, watchdog=1.0)
+    )
     streamed = [v[MAGNITUDE | 0] for _, name, v in device.log if name == "constant"][2:]
     pairs = np.array(streamed[: 2 * result.ticks]).reshape(-1, 2) / 10000 * 8.9
     np.testing.assert_allclose(pairs[:, 1], result.trace["F_y"], atol=8.9 / 10000)

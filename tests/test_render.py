@@ -156,12 +156,15 @@ def test_dahl_approaches_the_coulomb_level_exactly_and_never_overshoots():
     assert stiff.force(True, 0.0, -0.1, 1e-3) == pytest.approx(0.5)  # reversal: full level the other way
 
 
-@pytest.mark.parametrize("spec,message", [
-    ("glue:level=1N", "unknown friction model"),
-    ("coulomb:level=1", "not a force"),
-    ("coulomb:stiction=1N", "coulomb friction takes"),
-    ("karnopp:static=0.2N,coulomb=0.5N", "static ≥ coulomb"),
-])
+@pytest.mark.parametrize(
+    "spec,message",
+    [
+        ("glue:level=1N", "unknown friction model"),
+        ("coulomb:level=1", "not a force"),
+        ("coulomb:stiction=1N", "coulomb friction takes"),
+        ("karnopp:static=0.2N,coulomb=0.5N", "static ≥ coulomb"),
+    ],
+)
 def test_friction_specs_are_checked(spec, message):
     with pytest.raises(InputError, match=message):
         parse_friction(spec)
@@ -172,7 +175,9 @@ def test_friction_acts_along_the_surface_tangent():
     stroke = [(2e-3 + 2e-5 * k, 0.0, 0) for k in range(400)]  # 20 mm/s, the hand held at y = 0, under the ramp
     traces = []
     for friction in (None, parse_friction("coulomb:level=0.3N")):
-        traces.append(run(ScriptedDevice(stroke), [track], QuasiStatic(), friction, Settings(duration=0.3, realtime=False)).trace)
+        traces.append(
+            run(ScriptedDevice(stroke), [track], QuasiStatic(), friction, Settings(duration=0.3, realtime=False)).trace
+        )
     extra_x = traces[1]["F_x"] - traces[0]["F_x"]
     extra_y = traces[1]["F_y"] - traces[0]["F_y"]
     np.testing.assert_allclose(extra_x[20:], -0.3 / math.sqrt(1.25), rtol=1e-9)
@@ -324,17 +329,34 @@ def test_track_lookup_interpolates_between_nodes(heights, fraction):
     track = Track(heights, 1e-4)
     x = fraction * track.length
     assert track.at(x)[0] == pytest.approx(np.interp(x, np.arange(len(heights)) * 1e-4, heights), abs=1e-15)
-    assert track.at(x)[1] == pytest.approx(np.interp(x, np.arange(len(heights)) * 1e-4, np.gradient(heights, 1e-4)), abs=1e-9)
+    assert track.at(x)[1] == pytest.approx(
+        np.interp(x, np.arange(len(heights)) * 1e-4, np.gradient(heights, 1e-4)), abs=1e-9
+    )
 
 
 # -- the command ----------------------------------------------------------------------------
 
 
 def test_render_command_with_several_speeds(tmp_path):
-    profile = rough("synth", "--length", "20mm", "--dimension", "1.275", "--rq", "0.2781mm", "--seed", "1", check=True).stdout
-    result = rough("render", "--speed", "20mm/s", "--speed", "120mm/s", "--trace", tmp_path / "f-{speed}.tsv",
-                   "--plot", tmp_path / "forces.png", "--json", "--friction", "dahl:stiffness=1N/mm,coulomb=0.2N",
-                   input=profile, check=True)
+    profile = rough(
+        "synth", "--length", "20mm", "--dimension", "1.275", "--rq", "0.2781mm", "--seed", "1", check=True
+    ).stdout
+    result = rough(
+        "render",
+        "--speed",
+        "20mm/s",
+        "--speed",
+        "120mm/s",
+        "--trace",
+        tmp_path / "f-{speed}.tsv",
+        "--plot",
+        tmp_path / "forces.png",
+        "--json",
+        "--friction",
+        "dahl:stiffness=1N/mm,coulomb=0.2N",
+        input=profile,
+        check=True,
+    )
     runs = json.loads(result.stdout)["runs"]
     assert [r["speed"] for r in runs] == [0.02, 0.12]
     assert {"rate", "jitter_p99"}.isdisjoint(runs[0])  # unpaced: no timing to report
@@ -346,15 +368,20 @@ def test_render_command_with_several_speeds(tmp_path):
 
 def test_render_dynamic_realtime_reports_timing():
     profile = rough("synth", "--length", "5mm", "--dimension", "1.3", "--rq", "0.1mm", "--seed", "2", check=True).stdout
-    report = json.loads(rough("render", "--model", "dynamic", "--realtime", "--duration", "0.2s", "--json",
-                              input=profile, check=True).stdout)
+    report = json.loads(
+        rough(
+            "render", "--model", "dynamic", "--realtime", "--duration", "0.2s", "--json", input=profile, check=True
+        ).stdout
+    )
     assert report["ticks"] == 200 and report["rate"] == pytest.approx(1000, rel=0.05)
     assert {"jitter_p50", "jitter_p99", "jitter_max", "missed_deadlines"} <= set(report)
 
 
 def test_render_refusals(tmp_path):
     profile = rough("synth", "--length", "5mm", "--dimension", "1.3", "--rq", "0.1mm", "--seed", "2", check=True).stdout
-    assert_one_line_error(rough("render", "--speed", "1mm/s", "--speed", "2mm/s", "--trace", "t.tsv", input=profile), "{speed}")
+    assert_one_line_error(
+        rough("render", "--speed", "1mm/s", "--speed", "2mm/s", "--trace", "t.tsv", input=profile), "{speed}"
+    )
     assert_one_line_error(rough("render", "--friction", "glue", input=profile), "unknown friction model")
     assert_one_line_error(rough("render", "--stiffness", "3kg", input=profile), "not a stiffness")
     assert_one_line_error(rough("render", "--device", "usb", input=profile), "sim, hid or hid:VID:PID")
@@ -400,15 +427,29 @@ class TimedDevice(ScriptedDevice):
 
 
 @settings(max_examples=30, deadline=None)
-@given(st.lists(st.tuples(st.floats(-1.0, 1.0) | st.sampled_from([math.nan, math.inf, -math.inf]),
-                          st.floats(-1.0, 1.0) | st.sampled_from([math.nan, math.inf, -math.inf])), min_size=2, max_size=40),
-       st.floats(0.5, 20.0))
+@given(
+    st.lists(
+        st.tuples(
+            st.floats(-1.0, 1.0) | st.sampled_from([math.nan, math.inf, -math.inf]),
+            st.floats(-1.0, 1.0) | st.sampled_from([math.nan, math.inf, -math.inf]),
+        ),
+        min_size=2,
+        max_size=40,
+    ),
+    st.floats(0.5, 20.0),
+)
 def test_every_written_force_is_finite_and_within_the_limit(positions, limit):
     """Wild positions (deep in the surface, NaN, infinite) and friction: no force beyond
     the limit, nothing non-finite ever reaches the device."""
     device = ScriptedDevice([(x * 1e-2, y * 1e-2, 0) for x, y in positions])
     friction = parse_friction("karnopp:static=5N,coulomb=3N,viscous=100N*s/m")
-    run(device, [RAISED], QuasiStatic(stiffness=1e6), friction, Settings(duration=len(positions) * 1e-3, max_force=limit, realtime=False))
+    run(
+        device,
+        [RAISED],
+        QuasiStatic(stiffness=1e6),
+        friction,
+        Settings(duration=len(positions) * 1e-3, max_force=limit, realtime=False),
+    )
     forces_written = np.array(device.written)
     assert np.isfinite(forces_written).all()
     assert (np.hypot(forces_written[:, 0], forces_written[:, 1]) <= limit * (1 + 1e-12)).all()

@@ -88,7 +88,18 @@ def test_profiles_and_gaps_are_refused():
 
 
 def test_rose_command(tmp_path):
-    surface = rough("synth", "--size", "256x256", "--spacing", "10um", "--anisotropy", "2.2,1um,2.5,3um,30", "--seed", "5", check=True).stdout
+    surface = rough(
+        "synth",
+        "--size",
+        "256x256",
+        "--spacing",
+        "10um",
+        "--anisotropy",
+        "2.2,1um,2.5,3um,30",
+        "--seed",
+        "5",
+        check=True,
+    ).stdout
     values = json.loads(rough("rose", "--json", "--plot", tmp_path / "rose.png", input=surface, check=True).stdout)
     assert {"angles", "fractal_dimension", "amplitude_coefficient", "Str", "Std"} <= set(values)
     assert values["angles"] == [10.0 * k for k in range(18)]
@@ -101,12 +112,15 @@ def test_rose_command(tmp_path):
     assert_one_line_error(rough("rose", "--step", "7", input=surface), "must divide 180")
 
 
-@pytest.mark.parametrize("name,extra", [
-    ("SurfaceTopography/x3p-2.x3p", []),
-    ("SurfaceTopography/al3d-1.al3d", []),
-    ("opengps/KautschukInfiniteFocus.x3p", ["--fill"]),
-    ("x3ptools/sample-land.x3p", ["--fill"]),
-])
+@pytest.mark.parametrize(
+    "name,extra",
+    [
+        ("SurfaceTopography/x3p-2.x3p", []),
+        ("SurfaceTopography/al3d-1.al3d", []),
+        ("opengps/KautschukInfiniteFocus.x3p", ["--fill"]),
+        ("x3ptools/sample-land.x3p", ["--fill"]),
+    ],
+)
 def test_real_files(shared_data, name, extra):
     values = json.loads(rough("rose", "--json", *extra, shared_data / name, check=True).stdout)
     assert len(values["angles"]) == 18 and all(2.0 <= d <= 3.0 for d in values["fractal_dimension"])

@@ -20,13 +20,17 @@ offsets = st.floats(min_value=-1.0, max_value=1.0, allow_nan=False, allow_infini
 texts = st.text(max_size=30)
 metadata = st.dictionaries(st.sampled_from(["title", "instrument", "date", "comment", "operator"]), texts, max_size=4)
 history = st.lists(
-    st.fixed_dictionaries({
-        "command": st.sampled_from(["synth", "detrend", "convert"]),
-        "parameters": st.dictionaries(st.sampled_from(["seed", "order", "cutoff", "input"]),
-                                      st.one_of(st.integers(-10**6, 10**6), texts, st.floats(allow_nan=False))),
-        "version": st.just("0.1.0"),
-        "time": st.just("2026-11-20T00:00:00Z"),
-    }),
+    st.fixed_dictionaries(
+        {
+            "command": st.sampled_from(["synth", "detrend", "convert"]),
+            "parameters": st.dictionaries(
+                st.sampled_from(["seed", "order", "cutoff", "input"]),
+                st.one_of(st.integers(-(10**6), 10**6), texts, st.floats(allow_nan=False)),
+            ),
+            "version": st.just("0.1.0"),
+            "time": st.just("2026-11-20T00:00:00Z"),
+        }
+    ),
     max_size=3,
 )
 

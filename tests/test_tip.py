@@ -56,7 +56,9 @@ def test_a_sine_gentler_than_the_tip_keeps_its_shape():
     expected = np.interp(x, offset_x, offset_z)
     grid_error = (1 / radius + amplitude * k * k) * (1e-6) ** 2 / 4
     assert np.abs(path - expected)[inner].max() < grid_error + 1e-12
-    np.testing.assert_allclose(closing_envelope(profile(z, 1e-6), radius).heights[inner], z[inner], atol=grid_error + 1e-12)
+    np.testing.assert_allclose(
+        closing_envelope(profile(z, 1e-6), radius).heights[inner], z[inner], atol=grid_error + 1e-12
+    )
 
 
 @pytest.mark.parametrize("radius", [2e-4, 2.37e-4])
@@ -102,7 +104,9 @@ def test_a_ball_on_a_map_traces_a_spherical_cap_in_physical_units():
     path = traced(surface, radius).heights
     yy, xx = np.mgrid[-30:31, -40:41]
     distance = np.hypot(xx * 1e-5, yy * 2e-5)
-    cap = np.where(distance <= radius, np.maximum(1e-3 - radius + np.sqrt(np.maximum(radius**2 - distance**2, 0)), 0), 0)
+    cap = np.where(
+        distance <= radius, np.maximum(1e-3 - radius + np.sqrt(np.maximum(radius**2 - distance**2, 0)), 0), 0
+    )
     np.testing.assert_allclose(path, cap, atol=1e-18)
 
 
@@ -135,14 +139,18 @@ def test_the_envelope_never_lies_below_the_surface_and_is_idempotent(z, radius):
 
 
 @settings(max_examples=10, deadline=None)
-@given(z=arrays(np.float64, st.tuples(st.integers(5, 30), st.integers(5, 30)), elements=st.floats(-1e-4, 1e-4)),
-       radius=st.floats(2e-5, 1e-4))
+@given(
+    z=arrays(np.float64, st.tuples(st.integers(5, 30), st.integers(5, 30)), elements=st.floats(-1e-4, 1e-4)),
+    radius=st.floats(2e-5, 1e-4),
+)
 def test_map_envelope_bounds_and_idempotence(z, radius):
     surface = Surface(z, (1e-5, 1.5e-5))
     path = traced(surface, radius).heights
     once = closing_envelope(surface, radius).heights
     assert (path >= z).all() and (once >= z).all() and (once <= path).all()
-    np.testing.assert_allclose(closing_envelope(Surface(once, surface.spacing), radius).heights, once, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(
+        closing_envelope(Surface(once, surface.spacing), radius).heights, once, rtol=0, atol=1e-15
+    )
 
 
 def test_invalid_points_never_touch_the_tip_and_stay_invalid():
@@ -187,8 +195,20 @@ def test_a_tip_that_would_take_hours_is_refused_with_a_hint():
 
 
 def test_detrend_tip_and_envelope_commands():
-    source = rough("synth", "--length", "5mm", "--spacing", "10um", "--dimension", "1.3", "--rq", "0.1mm", "--seed", "4",
-                   check=True).stdout
+    source = rough(
+        "synth",
+        "--length",
+        "5mm",
+        "--spacing",
+        "10um",
+        "--dimension",
+        "1.3",
+        "--rq",
+        "0.1mm",
+        "--seed",
+        "4",
+        check=True,
+    ).stdout
     raw = json.loads(rough("features", "--json", input=source, check=True).stdout)
     path = rough("detrend", "--tip", "fingernail", input=source, check=True).stdout
     felt = json.loads(rough("features", "--json", input=path, check=True).stdout)
@@ -203,7 +223,9 @@ def test_detrend_tip_and_envelope_commands():
 
 
 def test_render_with_a_fingertip_feels_a_smoother_surface():
-    source = rough("synth", "--length", "20mm", "--dimension", "1.275", "--rq", "0.2781mm", "--seed", "1", check=True).stdout
+    source = rough(
+        "synth", "--length", "20mm", "--dimension", "1.275", "--rq", "0.2781mm", "--seed", "1", check=True
+    ).stdout
     bare = json.loads(rough("render", "--json", input=source, check=True).stdout)
     finger = json.loads(rough("render", "--json", "--tip", "fingertip", input=source, check=True).stdout)
     assert finger["F_x_rms"] < bare["F_x_rms"]

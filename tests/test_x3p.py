@@ -73,7 +73,7 @@ def test_binary_data_start_aligned_for_zero_copy_reading():
     blob = written(Surface(GRID, (1e-6, 1e-6)))
     with zipfile.ZipFile(io.BytesIO(blob)) as archive:
         info = archive.getinfo("bindata/data.bin")
-    name_length, extra_length = struct.unpack("<HH", blob[info.header_offset + 26: info.header_offset + 30])
+    name_length, extra_length = struct.unpack("<HH", blob[info.header_offset + 26 : info.header_offset + 30])
     assert (info.header_offset + 30 + name_length + extra_length) % 64 == 0
     surface = read_bytes(blob)
     assert surface.heights.flags.aligned and not surface.heights.flags.writeable
@@ -82,7 +82,9 @@ def test_binary_data_start_aligned_for_zero_copy_reading():
 # -- the variations of real X3P files ------------------------------------------------------
 
 
-@pytest.mark.parametrize("code,increment,offset", [("I", 1e-8, -0.5e-6), ("L", 1e-9, 2e-6), ("F", None, None), ("D", None, 1e-6)])
+@pytest.mark.parametrize(
+    "code,increment,offset", [("I", 1e-8, -0.5e-6), ("L", 1e-9, 2e-6), ("F", None, None), ("D", None, 1e-6)]
+)
 @pytest.mark.parametrize("inline", [False, True])
 def test_data_types_with_increment_and_offset(code, increment, offset, inline):
     rng = np.random.default_rng(3)

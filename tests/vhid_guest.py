@@ -72,9 +72,26 @@ def profiles(folder):
 
 
 def start_rough(folder, *extra):
-    command = [sys.executable, "-m", "rough", "render", "--device", f"hid:{VID:04x}:{PID:04x}", "--rate", "200",
-               "--ramp", "0", "--stick-span", "10mm,4mm", "--watchdog", "1s", "--json", *extra,
-               str(folder / "a.x3p"), str(folder / "b.x3p")]
+    command = [
+        sys.executable,
+        "-m",
+        "rough",
+        "render",
+        "--device",
+        f"hid:{VID:04x}:{PID:04x}",
+        "--rate",
+        "200",
+        "--ramp",
+        "0",
+        "--stick-span",
+        "10mm,4mm",
+        "--watchdog",
+        "1s",
+        "--json",
+        *extra,
+        str(folder / "a.x3p"),
+        str(folder / "b.x3p"),
+    ]
     return subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
 
@@ -108,24 +125,40 @@ def session(folder, first, second):
     stop.set()
     device.destroy()
     return {
-        "streaming": streaming, "startup_s": sweep_start - started, "setup": setup, "returncode": rough.returncode,
-        "stderr": err, "report": json.loads(out) if out.strip() else None, "final_force": device.model.force(),
-        "effects_left": len(device.model.effects), "actuators": device.model.actuators,
+        "streaming": streaming,
+        "startup_s": sweep_start - started,
+        "setup": setup,
+        "returncode": rough.returncode,
+        "stderr": err,
+        "report": json.loads(out) if out.strip() else None,
+        "final_force": device.model.force(),
+        "effects_left": len(device.model.effects),
+        "actuators": device.model.actuators,
         "after_close": [name for _, name, _ in device.model.log][-6:],
-        "streamed": _streamed(forces, trace), "physics": _physics(trace, first, second),
+        "streamed": _streamed(forces, trace),
+        "physics": _physics(trace, first, second),
     }
 
 
 def _streamed(forces, trace):
     """Pair the Set Constant Force reports (x block then y block, each tick) with the
     trace's forces: the largest difference in logical units."""
-    ticks = [(forces[i][2], forces[i + 1][2]) for i in range(2, len(forces) - 1, 2) if forces[i][1] == 1 and forces[i + 1][1] == 2]
+    ticks = [
+        (forces[i][2], forces[i + 1][2])
+        for i in range(2, len(forces) - 1, 2)
+        if forces[i][1] == 1 and forces[i + 1][1] == 2
+    ]
     count = min(len(ticks), trace.size)
-    expected = np.column_stack([np.round(trace["F_x"][:count] / MAX_FORCE * 10000), np.round(trace["F_y"][:count] / MAX_FORCE * 10000)])
+    expected = np.column_stack(
+        [np.round(trace["F_x"][:count] / MAX_FORCE * 10000), np.round(trace["F_y"][:count] / MAX_FORCE * 10000)]
+    )
     sent = np.array(ticks[:count], dtype=float)
-    return {"ticks": len(ticks), "trace_rows": int(trace.size),
-            "max_difference": float(np.abs(sent - expected).max()) if count else None,
-            "nonzero": int(np.count_nonzero(sent[:, 1])) if count else 0}
+    return {
+        "ticks": len(ticks),
+        "trace_rows": int(trace.size),
+        "max_difference": float(np.abs(sent - expected).max()) if count else None,
+        "nonzero": int(np.count_nonzero(sent[:, 1])) if count else 0,
+    }
 
 
 def _physics(trace, first, second):
@@ -136,14 +169,20 @@ def _physics(trace, first, second):
     on_second = np.isclose(trace["h"], np.interp(trace["x"], x, second), atol=1e-9)
     stiffness = 1280.0
     law = np.abs(trace["F_y"][touching] - np.clip(stiffness * (trace["h"] - trace["y_i"]), 0, None)[touching])
-    slope = np.where(on_second, np.interp(trace["x"], x, np.gradient(second, SPACING)),
-                     np.interp(trace["x"], x, np.gradient(first, SPACING)))
+    slope = np.where(
+        on_second,
+        np.interp(trace["x"], x, np.gradient(second, SPACING)),
+        np.interp(trace["x"], x, np.gradient(first, SPACING)),
+    )
     lateral = np.abs(trace["F_x"] + trace["F_y"] * slope)[touching]
     switch = int(np.argmax(on_second)) if on_second.any() else None
-    return {"contact_ticks": int(touching.sum()), "max_law_error_N": float(law.max()) if law.size else None,
-            "max_lateral_error_N": float(lateral.max()) if lateral.size else None,
-            "first_then_second": bool(switch is not None and on_first[:switch].all() and on_second[switch:].all()),
-            "switch_at_s": None if switch is None else float(trace["t"][switch])}
+    return {
+        "contact_ticks": int(touching.sum()),
+        "max_law_error_N": float(law.max()) if law.size else None,
+        "max_lateral_error_N": float(lateral.max()) if lateral.size else None,
+        "first_then_second": bool(switch is not None and on_first[:switch].all() and on_second[switch:].all()),
+        "switch_at_s": None if switch is None else float(trace["t"][switch]),
+    }
 
 
 def unplug(folder):
@@ -162,8 +201,13 @@ def unplug(folder):
         rough.kill()
         _, err = rough.communicate()
         hung = True
-    return {"streaming": streaming, "returncode": rough.returncode, "stderr": err, "hung": hung,
-            "exit_after_s": time.monotonic() - gone}
+    return {
+        "streaming": streaming,
+        "returncode": rough.returncode,
+        "stderr": err,
+        "hung": hung,
+        "exit_after_s": time.monotonic() - gone,
+    }
 
 
 def main():

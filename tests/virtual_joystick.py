@@ -45,8 +45,12 @@ class PidJoystick:
                     effect["playing"] = False
         elif name == "set_effect":
             effect = self.effects[block]
-            effect.update(type=EFFECT_TYPES[values[PAGE | 0x25] - 1], axes=(values[0x10030], values[0x10031]),
-                          duration=values[PAGE | 0x50], gain=values[PAGE | 0x52])
+            effect.update(
+                type=EFFECT_TYPES[values[PAGE | 0x25] - 1],
+                axes=(values[0x10030], values[0x10031]),
+                duration=values[PAGE | 0x50],
+                gain=values[PAGE | 0x52],
+            )
         elif name == "constant":
             self.effects[block]["magnitude"] = values[PAGE | 0x70]
         elif name == "operation":
@@ -79,7 +83,10 @@ class PidJoystick:
         self.stick = (old[0] if x is None else x, old[1] if y is None else y, old[2] if buttons is None else buttons)
         report = self.parsed.input_reports[self.layout.ids["input"]]
         low, high = self.layout.axis_range
-        values = {0x10030: round(low + self.stick[0] * (high - low)), 0x10031: round(low + self.stick[1] * (high - low))}
+        values = {
+            0x10030: round(low + self.stick[0] * (high - low)),
+            0x10031: round(low + self.stick[1] * (high - low)),
+        }
         for i in range(self.layout.buttons):
             values[0x90001 + i] = self.stick[2] >> i & 1
         return self._encode(report, values)
@@ -116,8 +123,13 @@ class PidJoystick:
         usages = {f.usage for f in report.fields} | {u for f in report.fields if f.usages for u in f.usages}
         if reports is self.parsed.feature_reports:
             return "create" if PAGE | 0x26 in usages else "load"
-        for key, test in (("set_effect", PAGE | 0x50), ("constant", PAGE | 0x70), ("operation", PAGE | 0x79),
-                          ("control", PAGE | 0x97), ("gain", PAGE | 0x7E)):
+        for key, test in (
+            ("set_effect", PAGE | 0x50),
+            ("constant", PAGE | 0x70),
+            ("operation", PAGE | 0x79),
+            ("control", PAGE | 0x97),
+            ("gain", PAGE | 0x7E),
+        ):
             if test in usages:
                 return key
         return "free"

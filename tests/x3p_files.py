@@ -84,7 +84,8 @@ def x3p_file(
         "<CalibrationDate>2019-12-31T00:00:00</CalibrationDate>"
         "<ProbingSystem><Type>Contacting</Type><Identification>2um tip</Identification></ProbingSystem>"
         "<Comment>hand-made test file</Comment></Record2>"
-        if record2 else ""
+        if record2
+        else ""
     )
     document = (
         f'<?xml version="1.0" encoding="UTF-8"?>{doctype}\n'

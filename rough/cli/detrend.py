@@ -9,18 +9,38 @@ from .options import LENGTH, TIP, crop_option, surface_input, surface_output
 @click.command(short_help="Remove polynomial form; split roughness and waviness (ISO 16610); trace with a round tip.")
 @surface_input
 @crop_option
-@click.option("--order", type=click.IntRange(0, 20),
-              help="Degree of the least-squares polynomial removed (maps: total degree in x and y); "
-                   "default 2, or none with --tip/--envelope.")
+@click.option(
+    "--order",
+    type=click.IntRange(0, 20),
+    help="Degree of the least-squares polynomial removed (maps: total degree in x and y); "
+    "default 2, or none with --tip/--envelope.",
+)
 @click.option("--cutoff", type=LENGTH, help="Gaussian filter cut-off λc (ISO 16610-21; 16610-61 for maps), e.g. 0.8mm.")
-@click.option("--keep", type=click.Choice(["roughness", "waviness", "form"]), default="roughness", show_default=True,
-              help="What to output: the roughness (form removed, filtered with --cutoff), the waviness (the Gaussian mean line) or the fitted form.")
-@click.option("--ends", type=click.Choice(["trim", "correct"]), default="trim", show_default=True,
-              help="Filter end effects: trim λc/2 at each end, or keep the full length with the renormalised kernel (ISO 16610-28).")
-@click.option("--tip", type=TIP,
-              help="Output the path of a round tip's apex drawn over the surface (disk for profiles, ball for maps): "
-                   "a radius, or needle (0.05 mm), fingernail (0.5 mm), fingertip (8 mm).")
-@click.option("--envelope", type=TIP, help="Output the ISO 16610-41 closing envelope with a disk or ball of this radius (or a preset).")
+@click.option(
+    "--keep",
+    type=click.Choice(["roughness", "waviness", "form"]),
+    default="roughness",
+    show_default=True,
+    help="What to output: the roughness (form removed, filtered with --cutoff), the waviness (the Gaussian mean line) or the fitted form.",
+)
+@click.option(
+    "--ends",
+    type=click.Choice(["trim", "correct"]),
+    default="trim",
+    show_default=True,
+    help="Filter end effects: trim λc/2 at each end, or keep the full length with the renormalised kernel (ISO 16610-28).",
+)
+@click.option(
+    "--tip",
+    type=TIP,
+    help="Output the path of a round tip's apex drawn over the surface (disk for profiles, ball for maps): "
+    "a radius, or needle (0.05 mm), fingernail (0.5 mm), fingertip (8 mm).",
+)
+@click.option(
+    "--envelope",
+    type=TIP,
+    help="Output the ISO 16610-41 closing envelope with a disk or ball of this radius (or a preset).",
+)
 @surface_output
 def detrend(surface, input, order, cutoff, keep, ends, tip, envelope, output):
     """Remove the least-squares polynomial form of degree --order (default 2, as the

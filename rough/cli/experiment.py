@@ -28,19 +28,50 @@ def experiment():
 
 @experiment.command(short_help="Write a study folder: surfaces with recorded seeds and the trial list.")
 @click.argument("study", metavar="STUDY")
-@click.option("--preset", type=click.Choice(["costa2000"]), help="The paper's design (its references, grid, length, resolution, 14 subjects).")
-@click.option("--reference", "references", multiple=True, metavar="D,RQ",
-              help="A reference surface, e.g. 1.275,0.2781mm (repeat for several sets).")
-@click.option("--dimension-step", type=click.FloatRange(0, 0.5, min_open=True), help="Neighbours' D offset (default 0.075).")
-@click.option("--rq-factor", type=click.FloatRange(1, 10, min_open=True), help="Neighbours' Rq ratio (default 0.3502/0.2781 = 1.2593).")
-@click.option("--subjects", help="A number of subjects (named S01, S02, …) or their names, comma-separated (default 14).")
+@click.option(
+    "--preset",
+    type=click.Choice(["costa2000"]),
+    help="The paper's design (its references, grid, length, resolution, 14 subjects).",
+)
+@click.option(
+    "--reference",
+    "references",
+    multiple=True,
+    metavar="D,RQ",
+    help="A reference surface, e.g. 1.275,0.2781mm (repeat for several sets).",
+)
+@click.option(
+    "--dimension-step", type=click.FloatRange(0, 0.5, min_open=True), help="Neighbours' D offset (default 0.075)."
+)
+@click.option(
+    "--rq-factor",
+    type=click.FloatRange(1, 10, min_open=True),
+    help="Neighbours' Rq ratio (default 0.3502/0.2781 = 1.2593).",
+)
+@click.option(
+    "--subjects", help="A number of subjects (named S01, S02, …) or their names, comma-separated (default 14)."
+)
 @click.option("--length", type=LENGTH, help="Profile length (default 80 mm).")
 @click.option("--spacing", type=LENGTH, help="Stored (rendered) spacing (default 0.1545 mm).")
 @click.option("--synthesis-spacing", type=LENGTH, help="Spacing the surfaces are synthesised at (default 0.0309 mm).")
-@click.option("--seed", type=click.IntRange(0), help="Seed of the surfaces and the randomisation (default: drawn and recorded).")
+@click.option(
+    "--seed", type=click.IntRange(0), help="Seed of the surfaces and the randomisation (default: drawn and recorded)."
+)
 @report_format
-def design(study, preset, references, dimension_step, rq_factor, subjects, length, spacing, synthesis_spacing, seed,
-           as_json, as_tsv):
+def design(
+    study,
+    preset,
+    references,
+    dimension_step,
+    rq_factor,
+    subjects,
+    length,
+    spacing,
+    synthesis_spacing,
+    seed,
+    as_json,
+    as_tsv,
+):
     """Write the study folder STUDY (it must not exist, or be empty): the surfaces,
     synthesised whole-length with recorded seeds, and trials.csv, each subject's pairs
     (every reference against each of its eight (D, Rq) neighbours) in random order with
@@ -56,18 +87,42 @@ def design(study, preset, references, dimension_step, rq_factor, subjects, lengt
         raise InputError("give --preset costa2000 or at least one --reference D,RQ")
     chosen = [_reference(text) for text in references] or defaults["references"]
     seed = secrets.randbits(32) if seed is None else seed
-    surfaces, sets = grid_design(chosen, dimension_step or defaults["dimension_step"], rq_factor or defaults["rq_factor"])
-    result = write_study(study, surfaces, sets, subject_ids(subjects or defaults["subjects"]), seed,
-                         length or defaults["length"], synthesis_spacing or defaults["synthesis_spacing"],
-                         spacing or defaults["spacing"], preset)
-    rows = [("study", str(result.folder), "", str(result.folder)),
-            ("sets", len(result.sets), "1", "; ".join(
+    surfaces, sets = grid_design(
+        chosen, dimension_step or defaults["dimension_step"], rq_factor or defaults["rq_factor"]
+    )
+    result = write_study(
+        study,
+        surfaces,
+        sets,
+        subject_ids(subjects or defaults["subjects"]),
+        seed,
+        length or defaults["length"],
+        synthesis_spacing or defaults["synthesis_spacing"],
+        spacing or defaults["spacing"],
+        preset,
+    )
+    rows = [
+        ("study", str(result.folder), "", str(result.folder)),
+        (
+            "sets",
+            len(result.sets),
+            "1",
+            "; ".join(
                 f"set {s['id']}: reference D = {result.surfaces[s['reference']]['dimension']:g}, "
-                f"Rq = {result.surfaces[s['reference']]['rq'] * 1e3:.4g} mm, {len(s['neighbours'])} neighbours" for s in result.sets)),
-            ("surfaces", len(result.surfaces), "1", f"{len(result.surfaces)} profiles in {result.folder / 'surfaces'}"),
-            ("subjects", result.subjects, "", f"{len(result.subjects)}: {', '.join(result.subjects)}"),
-            ("trials", len(result.trials), "1", f"{len(result.trials)} ({len(result.trials) // len(result.subjects)} per subject)"),
-            ("seed", seed, "", str(seed))]
+                f"Rq = {result.surfaces[s['reference']]['rq'] * 1e3:.4g} mm, {len(s['neighbours'])} neighbours"
+                for s in result.sets
+            ),
+        ),
+        ("surfaces", len(result.surfaces), "1", f"{len(result.surfaces)} profiles in {result.folder / 'surfaces'}"),
+        ("subjects", result.subjects, "", f"{len(result.subjects)}: {', '.join(result.subjects)}"),
+        (
+            "trials",
+            len(result.trials),
+            "1",
+            f"{len(result.trials)} ({len(result.trials) // len(result.subjects)} per subject)",
+        ),
+        ("seed", seed, "", str(seed)),
+    ]
     emit(rows, {key: value for key, value, _, _ in rows}, as_json, as_tsv)
 
 
@@ -94,11 +149,16 @@ def _reference(text):
 @click.argument("study", metavar="STUDY")
 @click.option("--subject", required=True, help="The subject's ID, as in the study (e.g. S01).")
 @haptic_options
-@click.option("--observer", metavar="rq=S1,dimension=S2[,spread=S][,bias=B][,seed=N]",
-              help="sim: the scripted observer's logistic slopes per mm of Rq and per unit of D, the SD of its "
-                   "per-subject intercepts, a bias and a seed.")
+@click.option(
+    "--observer",
+    metavar="rq=S1,dimension=S2[,spread=S][,bias=B][,seed=N]",
+    help="sim: the scripted observer's logistic slopes per mm of Rq and per unit of D, the SD of its "
+    "per-subject intercepts, a bias and a seed.",
+)
 @click.option("--speed", type=SPEED, default="60mm/s", show_default=True, help="sim: the hand's stroke speed.")
-@click.option("--stroke", type=TIME, default="1s", show_default=True, help="sim: how long the hand strokes each surface.")
+@click.option(
+    "--stroke", type=TIME, default="1s", show_default=True, help="sim: how long the hand strokes each surface."
+)
 @click.option("--realtime", is_flag=True, help="sim: stroke in real time instead of as fast as the machine allows.")
 def run(study, subject, haptics, observer, speed, stroke, realtime):
     """Present the unanswered trials of --subject in STUDY, in the study's order, and
@@ -119,12 +179,17 @@ def run(study, subject, haptics, observer, speed, stroke, realtime):
     if haptics.simulated:
         if observer is None:
             raise InputError("the simulated hand needs a scripted --observer (e.g. --observer rq=12,dimension=-4)")
-        present = simulated_presenter(loaded, parse_observer(observer), speed, contact, friction, haptics.settings(stroke, realtime))
+        present = simulated_presenter(
+            loaded, parse_observer(observer), speed, contact, friction, haptics.settings(stroke, realtime)
+        )
         progress = run_session(loaded, subject, present, "sim")
     else:
         progress = _joystick_session(loaded, subject, haptics, contact, friction)
     if progress.interrupted:
-        click.echo(f"{subject}: paused after {progress.answered} of {progress.total} trials; run the same command to resume", err=True)
+        click.echo(
+            f"{subject}: paused after {progress.answered} of {progress.total} trials; run the same command to resume",
+            err=True,
+        )
     click.echo(f"{subject}: {progress.answered} of {progress.total} trials answered, {progress.remaining} to go")
 
 
@@ -135,8 +200,9 @@ def _joystick_session(study, subject, haptics, contact, friction):
     from ..render.session import open_joystick
 
     tracks = {name: Track.from_surface(read(study.surface_path(name))) for name in study.surfaces}
-    joystick, label = open_joystick(haptics.device, list(tracks.values()), haptics.max_force, haptics.stick_span,
-                                    haptics.invert)
+    joystick, label = open_joystick(
+        haptics.device, list(tracks.values()), haptics.max_force, haptics.stick_span, haptics.invert
+    )
     keyboard = Keyboard()
     try:
         present = joystick_presenter(tracks, joystick, contact, friction, haptics.settings(), keyboard)
@@ -148,8 +214,12 @@ def _joystick_session(study, subject, haptics, contact, friction):
 
 @experiment.command(short_help="Logistic regression of the answers, Wald and likelihood-ratio tests.")
 @click.argument("study", metavar="STUDY")
-@click.option("--set", "set_id", type=int, help="Analyze one reference set (the paper's Tables 1 and 2 are sets 1 and 2).")
-@click.option("--plot", metavar="FILE", help="Draw the percentage of answers judging each test rougher (the paper's Figures 4-5).")
+@click.option(
+    "--set", "set_id", type=int, help="Analyze one reference set (the paper's Tables 1 and 2 are sets 1 and 2)."
+)
+@click.option(
+    "--plot", metavar="FILE", help="Draw the percentage of answers judging each test rougher (the paper's Figures 4-5)."
+)
 @report_format
 def analyze(study, set_id, plot, as_json, as_tsv):
     """Fit logit P(test judged rougher) = β0 + β_D ΔD + β_Rq ΔRq + Σ γ_s S_s to the
@@ -168,7 +238,8 @@ def analyze(study, set_id, plot, as_json, as_tsv):
     if result.separation:
         logging.getLogger("rough").warning(
             "(quasi-)separation: some answers are predicted with certainty (e.g. a subject who always chose the same "
-            "way), so those Wald statistics are unreliable (Hauck-Donner effect); trust the likelihood-ratio tests")
+            "way), so those Wald statistics are unreliable (Hauck-Donner effect); trust the likelihood-ratio tests"
+        )
     if plot:
         from .. import plots
 
@@ -188,17 +259,43 @@ def _table(study, result, set_id):
     rows = [("variable", None, "", f"{'coefficient':>12} {'std. error':>11} {'Wald W':>10} {'p':>11}")]
     for name, c in result.coefficients.items():
         label = LABELS.get(name, name.replace("subject_", "subject "))
-        rows.append((label, c["estimate"], c["unit"], f"{c['estimate']:12.5g} {c['stderr']:11.5g} {c['wald']:10.5g} {_p(c['p']):>11}"))
+        rows.append(
+            (
+                label,
+                c["estimate"],
+                c["unit"],
+                f"{c['estimate']:12.5g} {c['stderr']:11.5g} {c['wald']:10.5g} {_p(c['p']):>11}",
+            )
+        )
     chosen = [s for s in study.sets if set_id in (None, s["id"])]
-    scope = "; ".join(f"set {s['id']} (reference D = {study.surfaces[s['reference']]['dimension']:g}, "
-                      f"Rq = {study.surfaces[s['reference']]['rq'] * 1e3:.4g} mm)" for s in chosen)
+    scope = "; ".join(
+        f"set {s['id']} (reference D = {study.surfaces[s['reference']]['dimension']:g}, "
+        f"Rq = {study.surfaces[s['reference']]['rq'] * 1e3:.4g} mm)"
+        for s in chosen
+    )
     ratio = result.likelihood_ratio
     rows += [
-        ("answers", result.n, "1", f"{result.n} from {len(result.subjects)} subjects; {scope}; baseline subject {result.subjects[0]}"),
-        ("likelihood ratio", ratio, "",
-         (f"D: χ²(1) = {ratio['fractal_dimension']['statistic']:.4g}, p = {_p(ratio['fractal_dimension']['p'])};  "
-          f"Rq: χ²(1) = {ratio['rq']['statistic']:.4g}, p = {_p(ratio['rq']['p'])}")),
-        ("log-likelihood", result.log_likelihood, "", f"{result.log_likelihood:.4f}" + ("" if result.converged else " (not converged)")),
+        (
+            "answers",
+            result.n,
+            "1",
+            f"{result.n} from {len(result.subjects)} subjects; {scope}; baseline subject {result.subjects[0]}",
+        ),
+        (
+            "likelihood ratio",
+            ratio,
+            "",
+            (
+                f"D: χ²(1) = {ratio['fractal_dimension']['statistic']:.4g}, p = {_p(ratio['fractal_dimension']['p'])};  "
+                f"Rq: χ²(1) = {ratio['rq']['statistic']:.4g}, p = {_p(ratio['rq']['p'])}"
+            ),
+        ),
+        (
+            "log-likelihood",
+            result.log_likelihood,
+            "",
+            f"{result.log_likelihood:.4f}" + ("" if result.converged else " (not converged)"),
+        ),
     ]
     return rows
 

@@ -9,16 +9,32 @@ from .report import emit
 @click.command("fit-fractal", short_help="Fractal dimension D and amplitude coefficient C, with uncertainty.")
 @surface_input
 @crop_option
-@click.option("--band", type=BAND, help="Fit band FMIN:FMAX in cycles per length, e.g. 0.1/mm:20/mm (bare numbers per mm; an empty end is open).")
+@click.option(
+    "--band",
+    type=BAND,
+    help="Fit band FMIN:FMAX in cycles per length, e.g. 0.1/mm:20/mm (bare numbers per mm; an empty end is open).",
+)
 @click.option("--resolution", type=LENGTH, help="The resolution η at which C is stated (default: the spacing).")
-@click.option("--method", type=click.Choice(["whittle", "variogram", "madogram", "loglog"]), default="whittle", show_default=True,
-              help="Whittle likelihood of the spectrum (the estimator), or a cross-check (profiles only).")
-@click.option("--order", type=click.IntRange(0, 10), default=1, show_default=True, help="Polynomial form removed first.")
-@click.option("--sampling", type=click.Choice(["point", "band-limited"]),
-              help="Point samples (power above Nyquist folds back) or band-limited data; by default band-limited "
-                   "when rough synthesised or resampled the surface, point samples otherwise.")
+@click.option(
+    "--method",
+    type=click.Choice(["whittle", "variogram", "madogram", "loglog"]),
+    default="whittle",
+    show_default=True,
+    help="Whittle likelihood of the spectrum (the estimator), or a cross-check (profiles only).",
+)
+@click.option(
+    "--order", type=click.IntRange(0, 10), default=1, show_default=True, help="Polynomial form removed first."
+)
+@click.option(
+    "--sampling",
+    type=click.Choice(["point", "band-limited"]),
+    help="Point samples (power above Nyquist folds back) or band-limited data; by default band-limited "
+    "when rough synthesised or resampled the surface, point samples otherwise.",
+)
 @click.option("--fill", is_flag=True, help="Fill invalid points first (linear along profiles, biharmonic in maps).")
-@click.option("--psd", "psd_file", metavar="FILE", help="Write the log-binned spectrum as TSV (frequency 1/m, density, count).")
+@click.option(
+    "--psd", "psd_file", metavar="FILE", help="Write the log-binned spectrum as TSV (frequency 1/m, density, count)."
+)
 @click.option("--plot", metavar="FILE", help="Draw the spectrum on log-log axes with the fitted power law.")
 @report_format
 def fit_fractal(surface, input, band, resolution, method, order, sampling, fill, psd_file, plot, as_json, as_tsv):
@@ -53,9 +69,13 @@ def fit_fractal(surface, input, band, resolution, method, order, sampling, fill,
         document["parseval"] = spectrum["parseval"]
     if psd_file:
         unit = "m3" if surface.is_profile else "m4"
-        lines = [f"# rough fit-fractal: log-binned spectrum ({'Hann periodogram G' if surface.is_profile else 'ring-averaged P2'})",
-                 f"frequency_per_m\tdensity_{unit}\tcount"]
-        lines += [f"{f!r}\t{g!r}\t{n}" for f, g, n in zip(spectrum["frequency"], spectrum["density"], spectrum["count"])]
+        lines = [
+            f"# rough fit-fractal: log-binned spectrum ({'Hann periodogram G' if surface.is_profile else 'ring-averaged P2'})",
+            f"frequency_per_m\tdensity_{unit}\tcount",
+        ]
+        lines += [
+            f"{f!r}\t{g!r}\t{n}" for f, g, n in zip(spectrum["frequency"], spectrum["density"], spectrum["count"])
+        ]
         with atomic_output(psd_file) as stream:
             stream.write(("\n".join(lines) + "\n").encode())
     if plot:
@@ -63,8 +83,15 @@ def fit_fractal(surface, input, band, resolution, method, order, sampling, fill,
 
         from .. import plots
 
-        plots.save(plots.spectrum_figure(np.array(spectrum["frequency"]), np.array(spectrum["density"]), result,
-                                         surface.metadata.get("title", "power spectrum")), plot)
+        plots.save(
+            plots.spectrum_figure(
+                np.array(spectrum["frequency"]),
+                np.array(spectrum["density"]),
+                result,
+                surface.metadata.get("title", "power spectrum"),
+            ),
+            plot,
+        )
     emit(_rows(result, surface, document), document, as_json, as_tsv)
 
 
@@ -74,24 +101,55 @@ def _rows(result, surface, document):
     low, high = result.band
     key = "D" if surface.is_profile else "Ds"
     rows = [
-        ("fractal_dimension", result.fractal_dimension, "1",
-         f"{key} = {result.fractal_dimension:.4f} ± {result.fractal_dimension_stderr:.4f} (standard error)"),
+        (
+            "fractal_dimension",
+            result.fractal_dimension,
+            "1",
+            f"{key} = {result.fractal_dimension:.4f} ± {result.fractal_dimension_stderr:.4f} (standard error)",
+        ),
     ]
     if result.profile_dimension is not None:
-        rows.append(("profile_dimension", result.profile_dimension, "1", f"D = Ds - 1 = {result.profile_dimension:.4f} (profiles through the map)"))
+        rows.append(
+            (
+                "profile_dimension",
+                result.profile_dimension,
+                "1",
+                f"D = Ds - 1 = {result.profile_dimension:.4f} (profiles through the map)",
+            )
+        )
     rows += [
-        ("amplitude_coefficient", result.amplitude_coefficient, "m",
-         f"C = {format_length(result.amplitude_coefficient)} ± {format_length(result.amplitude_coefficient_stderr)} at η = {format_length(result.resolution)}"),
-        ("psd_prefactor", result.psd_prefactor, "m^(3-β)" if surface.is_profile else "m^(4-α)",
-         f"{result.psd_prefactor:.5g} (the spectrum at f = 1/m, SI units)"),
+        (
+            "amplitude_coefficient",
+            result.amplitude_coefficient,
+            "m",
+            f"C = {format_length(result.amplitude_coefficient)} ± {format_length(result.amplitude_coefficient_stderr)} at η = {format_length(result.resolution)}",
+        ),
+        (
+            "psd_prefactor",
+            result.psd_prefactor,
+            "m^(3-β)" if surface.is_profile else "m^(4-α)",
+            f"{result.psd_prefactor:.5g} (the spectrum at f = 1/m, SI units)",
+        ),
         ("hurst", result.hurst, "1", f"H = {result.hurst:.4f}"),
-        ("structure_function_coefficient", result.structure_function_coefficient, "m",
-         f"{format_length(result.structure_function_coefficient)} (Ganti & Bhushan's C_S at η)"),
-        ("band", list(result.band), "1/m",
-         (f"{low * 1e-3:.4g} to {high * 1e-3:.4g} /mm (wavelengths {format_length(1 / high)} to {format_length(1 / low)}), "
-          f"{result.frequencies_used} frequencies")),
+        (
+            "structure_function_coefficient",
+            result.structure_function_coefficient,
+            "m",
+            f"{format_length(result.structure_function_coefficient)} (Ganti & Bhushan's C_S at η)",
+        ),
+        (
+            "band",
+            list(result.band),
+            "1/m",
+            (
+                f"{low * 1e-3:.4g} to {high * 1e-3:.4g} /mm (wavelengths {format_length(1 / high)} to {format_length(1 / low)}), "
+                f"{result.frequencies_used} frequencies"
+            ),
+        ),
         ("method", result.method, "", f"{result.method}; window {result.window}; sampling {result.sampling}"),
     ]
     if "parseval" in document:
-        rows.append(("parseval", document["parseval"], "1", f"{document['parseval']:.12f} (Σ G Δf over the windowed variance)"))
+        rows.append(
+            ("parseval", document["parseval"], "1", f"{document['parseval']:.12f} (Σ G Δf over the windowed variance)")
+        )
     return rows

@@ -8,8 +8,17 @@ import click
 
 from .options import SPACING, QuantityType
 
-FORCE, STIFFNESS, DAMPING = QuantityType("force", "N"), QuantityType("stiffness", "N/mm"), QuantityType("damping", "N*s/m")
-MASS, SPEED, TIME, RATE = QuantityType("mass", "g"), QuantityType("speed", "mm/s"), QuantityType("time", "s"), QuantityType("rate", "Hz")
+FORCE, STIFFNESS, DAMPING = (
+    QuantityType("force", "N"),
+    QuantityType("stiffness", "N/mm"),
+    QuantityType("damping", "N*s/m"),
+)
+MASS, SPEED, TIME, RATE = (
+    QuantityType("mass", "g"),
+    QuantityType("speed", "mm/s"),
+    QuantityType("time", "s"),
+    QuantityType("rate", "Hz"),
+)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -49,8 +58,16 @@ class Haptics:
         from ..render import Settings
 
         ramp = self.ramp if self.ramp is not None else (0.0 if self.simulated else 0.5)
-        return Settings(rate=self.rate, duration=duration, max_force=self.max_force, velocity_cutoff=self.velocity_filter,
-                        watchdog=self.watchdog, priority=self.priority, ramp=ramp, realtime=realtime or not self.simulated)
+        return Settings(
+            rate=self.rate,
+            duration=duration,
+            max_force=self.max_force,
+            velocity_cutoff=self.velocity_filter,
+            watchdog=self.watchdog,
+            priority=self.priority,
+            ramp=ramp,
+            realtime=realtime or not self.simulated,
+        )
 
 
 def haptic_options(command):
@@ -65,29 +82,78 @@ def haptic_options(command):
         return command(*args, haptics=Haptics(**values), **kwargs)
 
     options = [
-        click.option("--device", default="sim", show_default=True, metavar="sim|hid[:VID:PID]",
-                     help="sim: a simulated hand; hid: the first HID PID force-feedback joystick (or the one with these hex IDs)."),
+        click.option(
+            "--device",
+            default="sim",
+            show_default=True,
+            metavar="sim|hid[:VID:PID]",
+            help="sim: a simulated hand; hid: the first HID PID force-feedback joystick (or the one with these hex IDs).",
+        ),
         click.option("--rate", type=RATE, default="1kHz", show_default=True, help="Servo rate."),
-        click.option("--model", type=click.Choice(["quasi-static", "dynamic"]), default="quasi-static", show_default=True,
-                     help="quasi-static: F = K·penetration (M, C negligible); dynamic: the stylus with mass and damping."),
+        click.option(
+            "--model",
+            type=click.Choice(["quasi-static", "dynamic"]),
+            default="quasi-static",
+            show_default=True,
+            help="quasi-static: F = K·penetration (M, C negligible); dynamic: the stylus with mass and damping.",
+        ),
         click.option("--stiffness", type=STIFFNESS, default="1.28N/mm", show_default=True, help="Contact stiffness K."),
-        click.option("--mass", type=MASS, default="1.85g", show_default=True,
-                     help="dynamic: stylus mass M (the slides' 1.85e-6 in N·s²/mm = 1.85 g; they print 1.85e-6 g, MATH §5.3)."),
-        click.option("--damping", type=DAMPING, default="4.6e-5N*s/mm", show_default=True, help="dynamic: stylus damping C."),
-        click.option("--friction", metavar="MODEL[:k=v,...]",
-                     help="coulomb:level=0.3N,viscous=2N*s/m | karnopp:static=0.8N,coulomb=0.5N,band=2mm/s,stiffness=1N/mm | "
-                          "dahl:stiffness=1N/mm,coulomb=0.5N (default none)."),
-        click.option("--max-force", type=FORCE, default="8.9N", show_default=True,
-                     help="Device maximum; the force vector is scaled to it."),
-        click.option("--stick-span", type=SPACING, metavar="X,Y",
-                     help="hid: lengths the stick's full x and y travel cover (default: the window, and 4× the profile's height range)."),
-        click.option("--invert", type=click.Choice(["x", "y"]), multiple=True, help="hid: reverse an axis (position and force)."),
-        click.option("--ramp", type=TIME, help="Ramp the force in over this time at the start (default: hid 0.5 s, sim none)."),
-        click.option("--velocity-filter", type=RATE, default="100Hz", show_default=True,
-                     help="Cut-off of the velocity estimate's low-pass filter."),
-        click.option("--watchdog", type=TIME, default="10ms", show_default=True, help="hid: zero the force if the loop stalls this long."),
-        click.option("--priority", type=click.IntRange(0, 99), default=50, show_default=True,
-                     help="Real-time loops: run at SCHED_FIFO priority N where permitted (0: normal scheduling)."),
+        click.option(
+            "--mass",
+            type=MASS,
+            default="1.85g",
+            show_default=True,
+            help="dynamic: stylus mass M (the slides' 1.85e-6 in N·s²/mm = 1.85 g; they print 1.85e-6 g, MATH §5.3).",
+        ),
+        click.option(
+            "--damping", type=DAMPING, default="4.6e-5N*s/mm", show_default=True, help="dynamic: stylus damping C."
+        ),
+        click.option(
+            "--friction",
+            metavar="MODEL[:k=v,...]",
+            help="coulomb:level=0.3N,viscous=2N*s/m | karnopp:static=0.8N,coulomb=0.5N,band=2mm/s,stiffness=1N/mm | "
+            "dahl:stiffness=1N/mm,coulomb=0.5N (default none).",
+        ),
+        click.option(
+            "--max-force",
+            type=FORCE,
+            default="8.9N",
+            show_default=True,
+            help="Device maximum; the force vector is scaled to it.",
+        ),
+        click.option(
+            "--stick-span",
+            type=SPACING,
+            metavar="X,Y",
+            help="hid: lengths the stick's full x and y travel cover (default: the window, and 4× the profile's height range).",
+        ),
+        click.option(
+            "--invert", type=click.Choice(["x", "y"]), multiple=True, help="hid: reverse an axis (position and force)."
+        ),
+        click.option(
+            "--ramp", type=TIME, help="Ramp the force in over this time at the start (default: hid 0.5 s, sim none)."
+        ),
+        click.option(
+            "--velocity-filter",
+            type=RATE,
+            default="100Hz",
+            show_default=True,
+            help="Cut-off of the velocity estimate's low-pass filter.",
+        ),
+        click.option(
+            "--watchdog",
+            type=TIME,
+            default="10ms",
+            show_default=True,
+            help="hid: zero the force if the loop stalls this long.",
+        ),
+        click.option(
+            "--priority",
+            type=click.IntRange(0, 99),
+            default=50,
+            show_default=True,
+            help="Real-time loops: run at SCHED_FIFO priority N where permitted (0: normal scheduling).",
+        ),
     ]
     for option in reversed(options):
         wrapper = option(wrapper)

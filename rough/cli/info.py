@@ -37,12 +37,21 @@ def info(surface, input, as_json, as_tsv):
         ("file", input, "", "standard input" if input == "-" else input),
         ("format", surface.source_format, "", describe(surface.source_format)),
         ("kind", facts["kind"], "", facts["kind"]),
-        ("shape", facts["shape"], "points", f"{x_by_y(map(str, facts['shape']))} points" + ("" if surface.is_profile else " (x × y)")),
+        (
+            "shape",
+            facts["shape"],
+            "points",
+            f"{x_by_y(map(str, facts['shape']))} points" + ("" if surface.is_profile else " (x × y)"),
+        ),
         ("spacing", facts["spacing"], "m", x_by_y(format_length(d) for d in facts["spacing"])),
         ("size", facts["size"], "m", x_by_y(format_length(s) for s in facts["size"])),
         ("origin", facts["origin"], "m", ", ".join(format_length(o) for o in facts["origin"])),
-        ("valid_points", facts["valid_points"], "points",
-         f"{facts['valid_points']} of {facts['points']} ({100 * facts['valid_points'] / facts['points']:.2f} %)"),
+        (
+            "valid_points",
+            facts["valid_points"],
+            "points",
+            f"{facts['valid_points']} of {facts['points']} ({100 * facts['valid_points'] / facts['points']:.2f} %)",
+        ),
         ("z_min", facts["z_min"], "m", _length(facts["z_min"])),
         ("z_max", facts["z_max"], "m", _length(facts["z_max"])),
         (rms_key, facts[rms_key], "m", f"{_length(facts[rms_key])} (valid points about their mean, not levelled)"),
@@ -64,4 +73,6 @@ def _length(value):
 
 def _history_line(entry):
     parameters = " ".join(f"{key}={value}" for key, value in entry.get("parameters", {}).items())
-    return f"{entry.get('time', '?')}  rough {entry.get('version', '?')} {entry.get('command', '?')} {parameters}".rstrip()
+    return (
+        f"{entry.get('time', '?')}  rough {entry.get('version', '?')} {entry.get('command', '?')} {parameters}".rstrip()
+    )

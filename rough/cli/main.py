@@ -146,7 +146,9 @@ def run(args):
         _report(error, debug)
         return error.exit_code
     except MemoryError as error:
-        _report(error, debug, "out of memory: the surface is too large for this machine (crop it, or resample it coarser)")
+        _report(
+            error, debug, "out of memory: the surface is too large for this machine (crop it, or resample it coarser)"
+        )
         return 1
     except OSError as error:
         where = f"{error.filename}: " if error.filename else ""

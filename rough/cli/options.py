@@ -146,7 +146,11 @@ def crop_option(command):
             surface = surface.crop(*crop)
         return command(*args, surface=surface, **kwargs)
 
-    return click.option("--crop", type=CROP, help="Evaluate only X0:X1 (and Y0:Y1 for maps), e.g. 468um:733um; positions include the origin.")(wrapper)
+    return click.option(
+        "--crop",
+        type=CROP,
+        help="Evaluate only X0:X1 (and Y0:Y1 for maps), e.g. 468um:733um; positions include the origin.",
+    )(wrapper)
 
 
 def input_options(spacing_flag="--spacing", most=1):
@@ -168,13 +172,23 @@ def input_options(spacing_flag="--spacing", most=1):
                 return command(*args, surfaces=surfaces, inputs=list(names), **kwargs)
             return command(*args, surface=surfaces[0], input=input, **kwargs)
 
-        argument = (click.argument("input", nargs=-1, metavar=f"[INPUT]{' [INPUT]' * (most - 1)}") if most > 1
-                    else click.argument("input", default="-", metavar="[INPUT]"))
+        argument = (
+            click.argument("input", nargs=-1, metavar=f"[INPUT]{' [INPUT]' * (most - 1)}")
+            if most > 1
+            else click.argument("input", default="-", metavar="[INPUT]")
+        )
         decorators = [
             argument,
-            click.option(spacing_flag, "spacing", type=SPACING, help="Spacing of input data that carry none (NPY, a column of heights), e.g. 1um or 1um,2um; overrides a file's own."),
+            click.option(
+                spacing_flag,
+                "spacing",
+                type=SPACING,
+                help="Spacing of input data that carry none (NPY, a column of heights), e.g. 1um or 1um,2um; overrides a file's own.",
+            ),
             click.option("--unit", metavar="UNIT", help="Length unit of text values that name none (default m)."),
-            click.option("--ignore-checksums", is_flag=True, help="Read X3P files whose MD5 checksums fail, with a warning."),
+            click.option(
+                "--ignore-checksums", is_flag=True, help="Read X3P files whose MD5 checksums fail, with a warning."
+            ),
         ]
         for decorator in reversed(decorators):
             wrapper = decorator(wrapper)
@@ -195,11 +209,18 @@ def surface_output(command):
         return command(*args, output=Output(output, format), **kwargs)
 
     wrapper = click.option(
-        "-f", "--format", type=click.Choice(FORMAT_CHOICES), default=None,
+        "-f",
+        "--format",
+        type=click.Choice(FORMAT_CHOICES),
+        default=None,
         help="Output format (default: from the output file's extension; X3P on standard output).",
     )(wrapper)
     wrapper = click.option(
-        "-o", "--output", default="-", metavar="FILE", show_default=True,
+        "-o",
+        "--output",
+        default="-",
+        metavar="FILE",
+        show_default=True,
         help="Output file, written atomically; - is standard output.",
     )(wrapper)
     return wrapper
@@ -229,7 +250,9 @@ class Output:
             write(surface, self.path, format=self.format)
             return
         if self.format in BINARY and sys.stdout.isatty():
-            raise InputError(f"refusing to write binary {self.format.upper()} to a terminal: use -o FILE, a pipe, or -f tsv")
+            raise InputError(
+                f"refusing to write binary {self.format.upper()} to a terminal: use -o FILE, a pipe, or -f tsv"
+            )
         try:
             write(surface, sys.stdout.buffer, format=self.format)
             sys.stdout.buffer.flush()

@@ -10,26 +10,64 @@ from .report import emit
 @click.command(short_help="The haptic contact loop on a USB force-feedback joystick or a simulated hand.")
 @input_options(most=2)
 @haptic_options
-@click.option("--speed", "speeds", type=SPEED, multiple=True, metavar="SPEED",
-              help="sim: stroke speed (default 20mm/s; repeat for several runs, e.g. --speed 20mm/s --speed 120mm/s).")
+@click.option(
+    "--speed",
+    "speeds",
+    type=SPEED,
+    multiple=True,
+    metavar="SPEED",
+    help="sim: stroke speed (default 20mm/s; repeat for several runs, e.g. --speed 20mm/s --speed 120mm/s).",
+)
 @click.option("--duration", type=TIME, help="Run length (default: sim one pass over the window; hid until Ctrl-C).")
 @click.option("--press", type=FORCE, default="1N", show_default=True, help="sim: the hand's downward push.")
 @click.option("--hand-mass", type=MASS, default="150g", show_default=True, help="sim: the hand's mass.")
 @click.option("--hand-damping", type=DAMPING, default="2N*s/m", show_default=True, help="sim: the hand's damping.")
-@click.option("--hand-stiffness", type=STIFFNESS,
-              help="sim: lateral stiffness holding the hand to its stroke (default rigid: it strokes at exactly --speed).")
-@click.option("--realtime", is_flag=True, help="sim: pace the loop in real time (as a joystick is) instead of running flat out.")
+@click.option(
+    "--hand-stiffness",
+    type=STIFFNESS,
+    help="sim: lateral stiffness holding the hand to its stroke (default rigid: it strokes at exactly --speed).",
+)
+@click.option(
+    "--realtime", is_flag=True, help="sim: pace the loop in real time (as a joystick is) instead of running flat out."
+)
 @click.option("--row", type=LENGTH, help="Maps: render the row at this y position (default the middle row).")
-@click.option("--crop", "window", type=CROP, help="The profile window X0:X1 to render (lengths; positions include the origin).")
+@click.option(
+    "--crop", "window", type=CROP, help="The profile window X0:X1 to render (lengths; positions include the origin)."
+)
 @click.option("--fill", is_flag=True, help="Fill invalid points first (linear interpolation).")
-@click.option("--tip", type=TIP,
-              help="Render what a round probe of this radius traces instead of the raw profile: a radius, or the "
-                   "presets needle (0.05 mm, a hypodermic needle), fingernail (0.5 mm), fingertip (8 mm).")
-@click.option("--trace", metavar="FILE", help="Write one row per tick (t x y_i h F_x F_y contact; .tsv or .npy); {speed} in the name for several speeds.")
+@click.option(
+    "--tip",
+    type=TIP,
+    help="Render what a round probe of this radius traces instead of the raw profile: a radius, or the "
+    "presets needle (0.05 mm, a hypodermic needle), fingernail (0.5 mm), fingertip (8 mm).",
+)
+@click.option(
+    "--trace",
+    metavar="FILE",
+    help="Write one row per tick (t x y_i h F_x F_y contact; .tsv or .npy); {speed} in the name for several speeds.",
+)
 @click.option("--plot", metavar="FILE", help="Draw the force profiles.")
 @report_format
-def render(surfaces, inputs, haptics, speeds, duration, press, hand_mass, hand_damping, hand_stiffness, realtime, row,
-           window, fill, tip, trace, plot, as_json, as_tsv):
+def render(
+    surfaces,
+    inputs,
+    haptics,
+    speeds,
+    duration,
+    press,
+    hand_mass,
+    hand_damping,
+    hand_stiffness,
+    realtime,
+    row,
+    window,
+    fill,
+    tip,
+    trace,
+    plot,
+    as_json,
+    as_tsv,
+):
     """Run the haptic contact loop on the profile INPUT (default: standard input): a
     virtual stylus rides the profile and the contact force (F_y = K·penetration,
     F_x = -F_y·h', resisting the climb) goes to the device, once per servo period,
@@ -70,8 +108,17 @@ def render(surfaces, inputs, haptics, speeds, duration, press, hand_mass, hand_d
     settings = haptics.settings(duration, realtime)
     contact, friction = haptics.contact(), haptics.friction_model()
     if haptics.simulated:
-        runs = run_sim(tracks[0], speeds or (0.02,), contact, friction, settings,
-                       press=press, hand_mass=hand_mass, hand_damping=hand_damping, lateral_stiffness=hand_stiffness)
+        runs = run_sim(
+            tracks[0],
+            speeds or (0.02,),
+            contact,
+            friction,
+            settings,
+            press=press,
+            hand_mass=hand_mass,
+            hand_damping=hand_damping,
+            lateral_stiffness=hand_stiffness,
+        )
     else:
         runs = [run_hid(haptics.device, tracks, contact, friction, settings, haptics.stick_span, haptics.invert)]
     _outputs(runs, trace, plot)

@@ -7,7 +7,9 @@ from .options import SPACING, input_options, surface_output
 
 @click.command(short_help="Resample to a new spacing without aliasing.")
 @input_options("--input-spacing")
-@click.option("--spacing", "new_spacing", type=SPACING, required=True, help="The new spacing, e.g. 0.1545mm (or DX,DY for maps).")
+@click.option(
+    "--spacing", "new_spacing", type=SPACING, required=True, help="The new spacing, e.g. 0.1545mm (or DX,DY for maps)."
+)
 @click.option("--fill", is_flag=True, help="Fill invalid points first (they are NaN again in the result).")
 @surface_output
 def resample(surface, input, new_spacing, fill, output):

@@ -9,11 +9,23 @@ from .report import emit
 @click.command(short_help="D(θ) and C(θ) by direction for maps (the amplitude coefficient rose); Str, Std.")
 @surface_input
 @crop_option
-@click.option("--step", type=click.FloatRange(1, 90), default=10.0, show_default=True, help="Angle between sector centres (degrees; must divide 180).")
-@click.option("--width", type=click.FloatRange(1, 180), help="Sector width in degrees (default: the step, sectors not overlapping).")
+@click.option(
+    "--step",
+    type=click.FloatRange(1, 90),
+    default=10.0,
+    show_default=True,
+    help="Angle between sector centres (degrees; must divide 180).",
+)
+@click.option(
+    "--width",
+    type=click.FloatRange(1, 180),
+    help="Sector width in degrees (default: the step, sectors not overlapping).",
+)
 @click.option("--band", type=BAND, help="Fit band FMIN:FMAX in cycles per length (bare numbers per mm).")
 @click.option("--resolution", type=LENGTH, help="The resolution η at which C is stated (default: the smaller spacing).")
-@click.option("--order", type=click.IntRange(0, 10), default=1, show_default=True, help="Polynomial form removed first.")
+@click.option(
+    "--order", type=click.IntRange(0, 10), default=1, show_default=True, help="Polynomial form removed first."
+)
 @click.option("--sampling", type=click.Choice(["point", "band-limited"]), help="As for fit-fractal.")
 @click.option("--fill", is_flag=True, help="Fill invalid points first (biharmonic inpainting).")
 @click.option("--plot", metavar="FILE", help="Draw polar roses of C(θ) and D(θ), mirrored to 360°.")
@@ -39,7 +51,9 @@ def rose(surface, input, step, width, band, resolution, order, sampling, fill, p
 
     if fill:
         surface = fill_invalid(surface)
-    result = directions(surface, step=step, width=width, band=band, resolution=resolution, order=order, sampling=sampling)
+    result = directions(
+        surface, step=step, width=width, band=band, resolution=resolution, order=order, sampling=sampling
+    )
     if plot:
         from .. import plots
 
@@ -51,37 +65,85 @@ def rose(surface, input, step, width, band, resolution, order, sampling, fill, p
 
 
 def _print_tsv(result):
-    click.echo("angle_deg\tfractal_dimension\tfractal_dimension_stderr\tamplitude_coefficient_m\tamplitude_coefficient_stderr_m")
-    for row in zip(result.angles, result.fractal_dimension, result.fractal_dimension_stderr,
-                   result.amplitude_coefficient, result.amplitude_coefficient_stderr):
+    click.echo(
+        "angle_deg\tfractal_dimension\tfractal_dimension_stderr\tamplitude_coefficient_m\tamplitude_coefficient_stderr_m"
+    )
+    for row in zip(
+        result.angles,
+        result.fractal_dimension,
+        result.fractal_dimension_stderr,
+        result.amplitude_coefficient,
+        result.amplitude_coefficient_stderr,
+    ):
         click.echo("\t".join(repr(float(value)) for value in row))
 
 
 def _rows(result):
     from ..units import format_length, format_quantity
 
-    rows = [(f"θ = {angle:5.1f}°", [d, c], "", f"Ds = {d:.4f} ± {de:.4f}   C = {format_length(c)} ± {format_length(ce)}")
-            for angle, d, de, c, ce in zip(result.angles, result.fractal_dimension, result.fractal_dimension_stderr,
-                                            result.amplitude_coefficient, result.amplitude_coefficient_stderr)]
+    rows = [
+        (f"θ = {angle:5.1f}°", [d, c], "", f"Ds = {d:.4f} ± {de:.4f}   C = {format_length(c)} ± {format_length(ce)}")
+        for angle, d, de, c, ce in zip(
+            result.angles,
+            result.fractal_dimension,
+            result.fractal_dimension_stderr,
+            result.amplitude_coefficient,
+            result.amplitude_coefficient_stderr,
+        )
+    ]
     principal, across = result.principal, result.perpendicular
     isotropy = result.isotropy_p_value
     rows += [
-        ("principal", result.principal_direction, "deg",
-         (f"{result.principal_direction:.1f}° (largest C of the rose's cos 2θ part): "
-          f"Ds = {principal['dimension']:.4f} ± {principal['dimension_error']:.4f}, "
-          f"C = {format_length(principal['amplitude'])} ± {format_length(principal['amplitude_error'])}")),
-        ("perpendicular", (result.principal_direction + 90) % 180, "deg",
-         (f"{(result.principal_direction + 90) % 180:.1f}°: "
-          f"Ds = {across['dimension']:.4f} ± {across['dimension_error']:.4f}, "
-          f"C = {format_length(across['amplitude'])} ± {format_length(across['amplitude_error'])}")),
-        ("lay", result.lay_direction, "deg", f"{result.lay_direction:.1f}° (ridges run at right angles to the principal wavevector)"),
-        ("largest_sector", result.largest_sector, "deg", f"{result.largest_sector:.1f}° (the sector with the largest C)"),
-        ("isotropy", isotropy, "", "not tested (overlapping sectors)" if isotropy["fractal_dimension"] is None else
-         f"χ² p-values: Ds flat {isotropy['fractal_dimension']:.3g}, C flat {isotropy['amplitude_coefficient']:.3g}"),
+        (
+            "principal",
+            result.principal_direction,
+            "deg",
+            (
+                f"{result.principal_direction:.1f}° (largest C of the rose's cos 2θ part): "
+                f"Ds = {principal['dimension']:.4f} ± {principal['dimension_error']:.4f}, "
+                f"C = {format_length(principal['amplitude'])} ± {format_length(principal['amplitude_error'])}"
+            ),
+        ),
+        (
+            "perpendicular",
+            (result.principal_direction + 90) % 180,
+            "deg",
+            (
+                f"{(result.principal_direction + 90) % 180:.1f}°: "
+                f"Ds = {across['dimension']:.4f} ± {across['dimension_error']:.4f}, "
+                f"C = {format_length(across['amplitude'])} ± {format_length(across['amplitude_error'])}"
+            ),
+        ),
+        (
+            "lay",
+            result.lay_direction,
+            "deg",
+            f"{result.lay_direction:.1f}° (ridges run at right angles to the principal wavevector)",
+        ),
+        (
+            "largest_sector",
+            result.largest_sector,
+            "deg",
+            f"{result.largest_sector:.1f}° (the sector with the largest C)",
+        ),
+        (
+            "isotropy",
+            isotropy,
+            "",
+            "not tested (overlapping sectors)"
+            if isotropy["fractal_dimension"] is None
+            else f"χ² p-values: Ds flat {isotropy['fractal_dimension']:.3g}, C flat {isotropy['amplitude_coefficient']:.3g}",
+        ),
         ("Str", result.Str, "1", f"{format_quantity(result.Str, '1')} (texture aspect ratio, ISO 25178-2)"),
         ("Std", result.Std, "deg", f"{format_quantity(result.Std, 'deg')} (lay direction from the angular spectrum)"),
-        ("band", list(result.band), "1/m",
-         (f"{result.band[0] * 1e-3:.4g} to {result.band[1] * 1e-3:.4g} /mm, sectors {result.width:g}° wide "
-          f"every {result.step:g}°, C at η = {format_length(result.resolution)}, sampling {result.sampling}")),
+        (
+            "band",
+            list(result.band),
+            "1/m",
+            (
+                f"{result.band[0] * 1e-3:.4g} to {result.band[1] * 1e-3:.4g} /mm, sectors {result.width:g}° wide "
+                f"every {result.step:g}°, C at η = {format_length(result.resolution)}, sampling {result.sampling}"
+            ),
+        ),
     ]
     return rows

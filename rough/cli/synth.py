@@ -43,23 +43,69 @@ class AnisotropyType(click.ParamType):
 @click.option("--length", type=LENGTH, help="Profile length, e.g. 80mm (a profile; or give --points).")
 @click.option("--points", type=click.IntRange(2, None), help="Profile length in points.")
 @click.option("--size", type=SizeType(), help="Map size in points, NXxNY (a map).")
-@click.option("--spacing", type=LENGTH, default="0.0309mm", show_default=True,
-              help="Sampling interval (the default is the paper's encoder resolution).")
-@click.option("--dimension", type=float,
-              help="Fractal dimension: D in (1, 2) for a profile, the surface dimension Ds in (2, 3) for a map.")
-@click.option("--amplitude", type=LENGTH, help="Amplitude coefficient C at --resolution: G(f) = C η^(2D-3) f^-(5-2D) (maps: C of their profiles).")
+@click.option(
+    "--spacing",
+    type=LENGTH,
+    default="0.0309mm",
+    show_default=True,
+    help="Sampling interval (the default is the paper's encoder resolution).",
+)
+@click.option(
+    "--dimension",
+    type=float,
+    help="Fractal dimension: D in (1, 2) for a profile, the surface dimension Ds in (2, 3) for a map.",
+)
+@click.option(
+    "--amplitude",
+    type=LENGTH,
+    help="Amplitude coefficient C at --resolution: G(f) = C η^(2D-3) f^-(5-2D) (maps: C of their profiles).",
+)
 @click.option("--resolution", type=LENGTH, help="The resolution η that C refers to (default: the spacing).")
-@click.option("--rq", type=LENGTH, help="RMS height instead of C: the realisation is scaled so its Rq (Sq), mean removed, is exactly this.")
-@click.option("--seed", type=click.IntRange(0, 2**63 - 1), help="Random seed; the same seed gives bit-identical output (recorded in the history either way).")
-@click.option("--anisotropy", type=AnisotropyType(),
-              help="Map: Ds and C along the wavevector direction ANGLE (degrees from +x) and at right angles, e.g. 2.2,1um,2.4,3um,30.")
-@click.option("--rolloff", type=LENGTH, help="Wavelength beyond which the spectrum is flat: self-affine only below it (rock is, over finite scales).")
-@click.option("--fragments", type=click.IntRange(4, None), is_flag=False, flag_value=128,
-              help="The paper's method, for comparison: fragments of this many points (default 128), each started where the last ended.")
+@click.option(
+    "--rq",
+    type=LENGTH,
+    help="RMS height instead of C: the realisation is scaled so its Rq (Sq), mean removed, is exactly this.",
+)
+@click.option(
+    "--seed",
+    type=click.IntRange(0, 2**63 - 1),
+    help="Random seed; the same seed gives bit-identical output (recorded in the history either way).",
+)
+@click.option(
+    "--anisotropy",
+    type=AnisotropyType(),
+    help="Map: Ds and C along the wavevector direction ANGLE (degrees from +x) and at right angles, e.g. 2.2,1um,2.4,3um,30.",
+)
+@click.option(
+    "--rolloff",
+    type=LENGTH,
+    help="Wavelength beyond which the spectrum is flat: self-affine only below it (rock is, over finite scales).",
+)
+@click.option(
+    "--fragments",
+    type=click.IntRange(4, None),
+    is_flag=False,
+    flag_value=128,
+    help="The paper's method, for comparison: fragments of this many points (default 128), each started where the last ended.",
+)
 @click.option("--as-printed", is_flag=True, help="With --fragments: also apply the paper's printed (k+1) index shift.")
 @surface_output
-def synth(length, points, size, spacing, dimension, amplitude, resolution, rq, seed, anisotropy, rolloff, fragments, as_printed,
-          output):
+def synth(
+    length,
+    points,
+    size,
+    spacing,
+    dimension,
+    amplitude,
+    resolution,
+    rq,
+    seed,
+    anisotropy,
+    rolloff,
+    fragments,
+    as_printed,
+    output,
+):
     """Synthesise a fractal profile (--length or --points) or map (--size) whose
     power spectrum is G(f) = C η^(2D-3) f^-(5-2D), in one inverse transform over
     the whole length: independent Gaussian coefficients, no DC term, so the
@@ -83,7 +129,9 @@ def synth(length, points, size, spacing, dimension, amplitude, resolution, rq, s
     if size is not None:
         if fragments or length is not None or points is not None:
             raise InputError("a map takes --size only (no --length, --points or --fragments)")
-        surface = make.synthesize_map(size, (spacing, spacing), dimension, amplitude, rq, resolution, seed, anisotropy, rolloff)
+        surface = make.synthesize_map(
+            size, (spacing, spacing), dimension, amplitude, rq, resolution, seed, anisotropy, rolloff
+        )
     else:
         if anisotropy is not None:
             raise InputError("--anisotropy needs a map (--size)")
@@ -91,7 +139,9 @@ def synth(length, points, size, spacing, dimension, amplitude, resolution, rq, s
         if fragments:
             if rolloff is not None:
                 raise InputError("--rolloff does not apply to the paper's fragments")
-            surface = make.synthesize_fragments(count, spacing, dimension, amplitude, rq, resolution, seed, fragments, as_printed)
+            surface = make.synthesize_fragments(
+                count, spacing, dimension, amplitude, rq, resolution, seed, fragments, as_printed
+            )
         else:
             surface = make.synthesize_profile(count, spacing, dimension, amplitude, rq, resolution, seed, rolloff)
     output.write(surface)

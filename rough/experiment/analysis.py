@@ -54,10 +54,14 @@ def answers_table(study, set_id=None):
         raise InputError(f"{study.folder}: answers from subjects not in the study: {', '.join(sorted(known))}")
     if set_id is not None:
         if set_id not in {s["id"] for s in study.sets}:
-            raise InputError(f"{study.folder}: no reference set {set_id} (sets: {', '.join(str(s['id']) for s in study.sets)})")
+            raise InputError(
+                f"{study.folder}: no reference set {set_id} (sets: {', '.join(str(s['id']) for s in study.sets)})"
+            )
         rows = [row for row in rows if int(row["set"]) == set_id]
     if not rows:
-        raise InputError(f"{study.folder}: no answers yet{'' if set_id is None else f' for set {set_id}'} (run sessions with rough experiment run)")
+        raise InputError(
+            f"{study.folder}: no answers yet{'' if set_id is None else f' for set {set_id}'} (run sessions with rough experiment run)"
+        )
     return {
         "rougher": np.array([int(r["test_rougher"]) for r in rows], dtype=float),
         "dimension": np.array([float(r["test_dimension"]) - float(r["reference_dimension"]) for r in rows]),
@@ -83,8 +87,13 @@ def fit(table, subject_order=None):
     coefficients = {}
     for name, estimate, stderr in zip(columns, full.params, full.bse):
         wald = float(estimate / stderr) if stderr > 0 else math.nan
-        coefficients[name] = {"estimate": float(estimate), "stderr": float(stderr), "wald": wald,
-                              "p": wald_p(wald) if math.isfinite(wald) else math.nan, "unit": units.get(name, "logit")}
+        coefficients[name] = {
+            "estimate": float(estimate),
+            "stderr": float(stderr),
+            "wald": wald,
+            "p": wald_p(wald) if math.isfinite(wald) else math.nan,
+            "unit": units.get(name, "logit"),
+        }
     ratio = {}
     for name in ("fractal_dimension", "rq"):
         reduced = _logit(table["rougher"], {k: v for k, v in columns.items() if k != name})
@@ -93,9 +102,19 @@ def fit(table, subject_order=None):
 
         ratio[name] = {"statistic": statistic, "p": float(chi2.sf(statistic, 1))}
     design = np.column_stack(list(columns.values()))
-    separation = (not full.mle_retvals.get("converged", True)) or bool(np.abs(design @ full.params).max() > SEPARATED_LOGIT)
-    return Analysis(coefficients, int(table["rougher"].size), subjects, float(full.llf), ratio, separation,
-                    bool(full.mle_retvals.get("converged", True)), sorted(set(table["set"])))
+    separation = (not full.mle_retvals.get("converged", True)) or bool(
+        np.abs(design @ full.params).max() > SEPARATED_LOGIT
+    )
+    return Analysis(
+        coefficients,
+        int(table["rougher"].size),
+        subjects,
+        float(full.llf),
+        ratio,
+        separation,
+        bool(full.mle_retvals.get("converged", True)),
+        sorted(set(table["set"])),
+    )
 
 
 def _logit(response, columns):
@@ -103,7 +122,9 @@ def _logit(response, columns):
 
     design = np.column_stack(list(columns.values()))
     if np.linalg.matrix_rank(design) < design.shape[1]:
-        raise InputError("the design is degenerate: a predictor is a combination of others (too few trials or subjects)")
+        raise InputError(
+            "the design is degenerate: a predictor is a combination of others (too few trials or subjects)"
+        )
     with warnings.catch_warnings(), np.errstate(over="ignore", divide="ignore", invalid="ignore"):
         warnings.simplefilter("ignore")
         return sm.Logit(response, design).fit(disp=0, method="newton", maxiter=100)
@@ -117,8 +138,13 @@ def percentages(study, set_id):
     result = []
     for name in entry["neighbours"]:
         test = study.surfaces[name]
-        chosen = [r for r, d, q in zip(table["rougher"], table["dimension"], table["rq"])
-                  if math.isclose(d, test["dimension"] - reference["dimension"], abs_tol=1e-9)
-                  and math.isclose(q, (test["rq"] - reference["rq"]) * 1e3, abs_tol=1e-9)]
-        result.append((name, test["dimension"], test["rq"], 100.0 * np.mean(chosen) if chosen else math.nan, len(chosen)))
+        chosen = [
+            r
+            for r, d, q in zip(table["rougher"], table["dimension"], table["rq"])
+            if math.isclose(d, test["dimension"] - reference["dimension"], abs_tol=1e-9)
+            and math.isclose(q, (test["rq"] - reference["rq"]) * 1e3, abs_tol=1e-9)
+        ]
+        result.append(
+            (name, test["dimension"], test["rq"], 100.0 * np.mean(chosen) if chosen else math.nan, len(chosen))
+        )
     return result

@@ -99,8 +99,17 @@ def trial_list(sets, subjects, seed):
         test_first = generator.integers(0, 2, size=len(pairs)).astype(bool)
         for number, (k, first) in enumerate(zip(order, test_first), start=1):
             set_id, reference, test = pairs[k]
-            trials.append({"subject": subject, "trial": number, "set": set_id, "reference": reference, "test": test,
-                           "first": test if first else reference, "second": reference if first else test})
+            trials.append(
+                {
+                    "subject": subject,
+                    "trial": number,
+                    "set": set_id,
+                    "reference": reference,
+                    "test": test,
+                    "first": test if first else reference,
+                    "second": reference if first else test,
+                }
+            )
     return trials
 
 
@@ -137,15 +146,30 @@ def write_study(folder, surfaces, sets, subjects, seed, length, synthesis_spacin
         (staging / "surfaces").mkdir()
         (staging / "answers").mkdir()
         for (name, surface), surface_seed in zip(sorted(surfaces.items()), seeds):
-            profile = synthesize_profile(points, synthesis_spacing, surface["dimension"], rq=surface["rq"], seed=int(surface_seed))
+            profile = synthesize_profile(
+                points, synthesis_spacing, surface["dimension"], rq=surface["rq"], seed=int(surface_seed)
+            )
             if not math.isclose(spacing, synthesis_spacing):
                 profile = resample(profile, spacing)
-            profile.metadata["title"] = f"study surface {name}: D = {surface['dimension']:g}, Rq = {surface['rq'] * 1e3:.4g} mm"
+            profile.metadata["title"] = (
+                f"study surface {name}: D = {surface['dimension']:g}, Rq = {surface['rq'] * 1e3:.4g} mm"
+            )
             profile.write(staging / "surfaces" / f"{name}.x3p")
             heights = profile.heights - profile.heights.mean()
-            surface.update(file=f"surfaces/{name}.x3p", seed=int(surface_seed), rq_measured=float(np.sqrt(np.mean(heights**2))))
-        document = {"format": FORMAT, "preset": preset, "seed": seed, "length": length, "synthesis_spacing": synthesis_spacing,
-                    "spacing": spacing, "subjects": subjects, "sets": sets, "surfaces": surfaces}
+            surface.update(
+                file=f"surfaces/{name}.x3p", seed=int(surface_seed), rq_measured=float(np.sqrt(np.mean(heights**2)))
+            )
+        document = {
+            "format": FORMAT,
+            "preset": preset,
+            "seed": seed,
+            "length": length,
+            "synthesis_spacing": synthesis_spacing,
+            "spacing": spacing,
+            "subjects": subjects,
+            "sets": sets,
+            "surfaces": surfaces,
+        }
         (staging / "study.json").write_text(json.dumps(document, indent=2) + "\n")
         _write_trials(staging / "trials.csv", trial_list(sets, subjects, seed))
         if folder.exists():
@@ -170,7 +194,12 @@ def load_study(folder):
     if not isinstance(document, dict) or document.get("format") != FORMAT:
         raise InputError(f"{path}: not a {FORMAT} file")
     try:
-        surfaces, sets, subjects, seed = document["surfaces"], document["sets"], document["subjects"], int(document["seed"])
+        surfaces, sets, subjects, seed = (
+            document["surfaces"],
+            document["sets"],
+            document["subjects"],
+            int(document["seed"]),
+        )
         for surface in surfaces.values():
             float(surface["dimension"]), float(surface["rq"]), str(surface["file"])
         for entry in sets:
@@ -205,8 +234,7 @@ def _read_trials(path, surfaces, subjects):
         except ValueError:
             raise InputError(f"{path}, line {line}: trial and set must be whole numbers") from None
         names = {trial["reference"], trial["test"]}
-        if (not names <= set(surfaces) or {trial["first"], trial["second"]} != names
-                or trial["subject"] not in subjects):
+        if not names <= set(surfaces) or {trial["first"], trial["second"]} != names or trial["subject"] not in subjects:
             raise InputError(f"{path}, line {line}: unknown surface or subject, or first/second not the pair")
         trials.append(trial)
     return trials

@@ -44,7 +44,9 @@ def parse_observer(spec):
         key, equals, value = item.partition("=")
         key = key.strip()
         if not equals or key not in KEYS:
-            raise InputError(f"--observer takes {', '.join(f'{k}=' for k in KEYS)} ({', '.join(f'{k}: {v}' for k, v in KEYS.items())}); not {item!r}")
+            raise InputError(
+                f"--observer takes {', '.join(f'{k}=' for k in KEYS)} ({', '.join(f'{k}: {v}' for k, v in KEYS.items())}); not {item!r}"
+            )
         try:
             values[key] = int(value) if key == "seed" else float(value)
         except ValueError:

@@ -24,8 +24,18 @@ import time
 from ..errors import InputError
 from .design import TRIAL_FIELDS
 
-ANSWER_FIELDS = TRIAL_FIELDS + ("answer", "test_rougher", "reference_dimension", "reference_rq_m", "test_dimension",
-                                "test_rq_m", "response_time_s", "toggles", "device", "finished")
+ANSWER_FIELDS = TRIAL_FIELDS + (
+    "answer",
+    "test_rougher",
+    "reference_dimension",
+    "reference_rq_m",
+    "test_dimension",
+    "test_rq_m",
+    "response_time_s",
+    "toggles",
+    "device",
+    "finished",
+)
 ANSWER_BUTTONS = {2: "first", 4: "second"}  # button 2, button 3 (bit masks)
 ANSWER_KEYS = {"1": "first", "2": "second"}
 
@@ -93,11 +103,19 @@ def run_session(study, subject, present, device_name):
 def _answer_row(study, trial, answer, seconds, toggles, device_name):
     test, reference = study.surfaces[trial["test"]], study.surfaces[trial["reference"]]
     rougher = int(trial[answer] == trial["test"])
-    return {**{key: trial[key] for key in TRIAL_FIELDS}, "answer": answer, "test_rougher": rougher,
-            "reference_dimension": reference["dimension"], "reference_rq_m": reference["rq"],
-            "test_dimension": test["dimension"], "test_rq_m": test["rq"], "response_time_s": f"{seconds:.3f}",
-            "toggles": toggles, "device": device_name,
-            "finished": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")}
+    return {
+        **{key: trial[key] for key in TRIAL_FIELDS},
+        "answer": answer,
+        "test_rougher": rougher,
+        "reference_dimension": reference["dimension"],
+        "reference_rq_m": reference["rq"],
+        "test_dimension": test["dimension"],
+        "test_rq_m": test["rq"],
+        "response_time_s": f"{seconds:.3f}",
+        "toggles": toggles,
+        "device": device_name,
+        "finished": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
+    }
 
 
 def _save(path, rows):
@@ -131,8 +149,9 @@ def simulated_presenter(study, observer, speed, model, friction, settings, **han
                 return None
             seconds += stroke.timing()["simulated_time"]
         test, reference = study.surfaces[trial["test"]], study.surfaces[trial["reference"]]
-        rougher = observer.judges_test_rougher(trial["subject"], trial["trial"], test["dimension"] - reference["dimension"],
-                                               test["rq"] - reference["rq"])
+        rougher = observer.judges_test_rougher(
+            trial["subject"], trial["trial"], test["dimension"] - reference["dimension"], test["rq"] - reference["rq"]
+        )
         test_side = "first" if trial["first"] == trial["test"] else "second"
         return (test_side if rougher else ("second" if test_side == "first" else "first")), seconds, 1
 

@@ -109,7 +109,9 @@ def fit_fractal(surface, band=None, resolution=None, method="whittle", order=1, 
     if surface.is_profile:
         if sector is not None:
             raise InputError("a direction (sector) needs a map")
-        fitter = {"whittle": _whittle_profile, "variogram": _variogram, "madogram": _madogram, "loglog": _loglog}[method]
+        fitter = {"whittle": _whittle_profile, "variogram": _variogram, "madogram": _madogram, "loglog": _loglog}[
+            method
+        ]
         if method == "whittle" and (band is None or band[1] is None):
             band = ((band or (None, None))[0], default_top(surface, 0.5 / surface.spacing[0], sampling))
         levelled = detrend(surface, order=order).heights
@@ -146,8 +148,17 @@ def _whittle_profile(heights, spacing, band, resolution, sampling):
     scale = np.mean(ordinates * np.exp(-shape(beta)))  # = 2A
     derivative = (shape(beta + 1e-5) - shape(beta - 1e-5)) / 2e-5
     covariance = np.linalg.inv(np.array([[len(u), derivative.sum()], [derivative.sum(), (derivative**2).sum()]]))
-    return _result(beta, covariance, scale / 2, resolution, _band_of(frequencies[keep]), "whittle",
-                   "none (first differences)", sampling, len(u))
+    return _result(
+        beta,
+        covariance,
+        scale / 2,
+        resolution,
+        _band_of(frequencies[keep]),
+        "whittle",
+        "none (first differences)",
+        sampling,
+        len(u),
+    )
 
 
 def _difference_shape(u, spacing, sampling):
@@ -187,8 +198,10 @@ def at_fractal_edge(beta):
 
 
 def warn_at_edge(where="", dimension="D at 1 or 2"):
-    log.warning(f"the fitted exponent is at the edge of the fractal range ({dimension}){where}: the data do not "
-                "follow a fractal power law in this band (see --band)")
+    log.warning(
+        f"the fitted exponent is at the edge of the fractal range ({dimension}){where}: the data do not "
+        "follow a fractal power law in this band (see --band)"
+    )
 
 
 def _result(beta, covariance, prefactor, resolution, band, method, window, sampling, count):
@@ -351,8 +364,17 @@ def _blocks(heights, estimate, count=8):
 def _lag_result(heights, spacing, resolution, statistic, sampling):
     dimension, amplitude = _lag_fit(heights, spacing, resolution, statistic)
     error = _blocks(heights, lambda part: _lag_fit(part, spacing, resolution, statistic)[0])
-    fit = _result(5.0 - 2.0 * dimension, np.zeros((2, 2)), model.prefactor(amplitude, dimension, resolution),
-                  resolution, (1 / (2 * spacing), 1 / spacing), statistic, "none", sampling, 2)
+    fit = _result(
+        5.0 - 2.0 * dimension,
+        np.zeros((2, 2)),
+        model.prefactor(amplitude, dimension, resolution),
+        resolution,
+        (1 / (2 * spacing), 1 / spacing),
+        statistic,
+        "none",
+        sampling,
+        2,
+    )
     fit.fractal_dimension_stderr = error
     fit.amplitude_coefficient_stderr = math.nan
     return fit
@@ -382,8 +404,17 @@ def _loglog_estimate(heights, spacing, band):
 
 def _loglog(heights, spacing, band, resolution, sampling):
     beta, prefactor, used, count = _loglog_estimate(heights, spacing, band)
-    fit = _result(beta, np.zeros((2, 2)), prefactor, resolution, used, "loglog (log-binned, band-limited)", "hann",
-                  sampling, count)
+    fit = _result(
+        beta,
+        np.zeros((2, 2)),
+        prefactor,
+        resolution,
+        used,
+        "loglog (log-binned, band-limited)",
+        "hann",
+        sampling,
+        count,
+    )
     fit.fractal_dimension_stderr = _blocks(heights, lambda part: (5.0 - _loglog_estimate(part, spacing, None)[0]) / 2)
     fit.amplitude_coefficient_stderr = math.nan
     return fit

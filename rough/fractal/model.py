@@ -33,8 +33,13 @@ def check_dimension(dimension, profile):
     low, high = (1.0, 2.0) if profile else (2.0, 3.0)
     if not low < dimension < high:
         kind = "profile" if profile else "map (surface dimension Ds)"
-        hint = (" — for a map give the surface dimension Ds = D + 1" if profile and 2 < dimension < 3 else
-                " — for a profile give D = Ds - 1" if not profile and 1 < dimension < 2 else "")
+        hint = (
+            " — for a map give the surface dimension Ds = D + 1"
+            if profile and 2 < dimension < 3
+            else " — for a profile give D = Ds - 1"
+            if not profile and 1 < dimension < 2
+            else ""
+        )
         raise InputError(f"a {kind} needs a fractal dimension between {low:g} and {high:g}, not {dimension:g}{hint}")
 
 
@@ -69,7 +74,11 @@ def structure_factor(dimension):
     """C_P / C_S: Ganti & Bhushan's structure-function coefficient C_S
     (S(τ) = C_S η^(2D-3) τ^(4-2D)) gives G with C_P = C_S · Γ(5-2D) sin(π(2-D)) /
     (π (2π)^(4-2D)) (MATH §1.2)."""
-    return math.gamma(5 - 2 * dimension) * math.sin(math.pi * (2 - dimension)) / (math.pi * (2 * math.pi) ** (4 - 2 * dimension))
+    return (
+        math.gamma(5 - 2 * dimension)
+        * math.sin(math.pi * (2 - dimension))
+        / (math.pi * (2 * math.pi) ** (4 - 2 * dimension))
+    )
 
 
 def eq2_rq(amplitude_value, dimension, resolution, length, sampling=None):

@@ -13,7 +13,6 @@ Other conventions of the same spectrum (all functions of frequency f in 1/m):
 - Ganti & Bhushan's two-sided angular ``P(ω) = G(ω/2π)/(4π)`` (Rq² = ∫_-∞^∞ P dω).
 """
 
-
 import math
 
 import numpy as np
@@ -131,9 +130,11 @@ def sector_spectra(field, power, spacing, low, high, step, sectors=None, rows_pe
         radius = np.sqrt(squared)
         keep = (radius >= low) & (radius <= high)
         ring = np.floor(radius / step).astype(np.int64)
-        power_here = _power(transform[rows, 1: (nx + 1) // 2])
+        power_here = _power(transform[rows, 1 : (nx + 1) // 2])
         if paired:
-            power_here += np.where(partners != rows, 1.0, 0.0)[:, np.newaxis] * _power(transform[partners, 1: (nx + 1) // 2])
+            power_here += np.where(partners != rows, 1.0, 0.0)[:, np.newaxis] * _power(
+                transform[partners, 1 : (nx + 1) // 2]
+            )
         log_radius = np.log(radius)
         columns = [
             np.broadcast_to(weight, radius.shape).ravel(),
@@ -149,19 +150,21 @@ def sector_spectra(field, power, spacing, low, high, step, sectors=None, rows_pe
                 sums[row] += np.bincount(index, values, minlength=groups * stride + 1)
     results = []
     for group in range(groups):
-        part = sums[:, group * stride: group * stride + rings]
+        part = sums[:, group * stride : group * stride + rings]
         used = part[0] > 0
         counts = part[0][used]
         means = part[1:, used] / counts
-        results.append({
-            "count": counts.astype(np.int64),
-            "density": means[0],
-            "log_radius": means[1],
-            "log_spread": np.maximum(means[2] - means[1] ** 2, 0.0),
-            "window_a": means[3],
-            "window_b": means[4],
-            "window_factor": window_variance_factor(ny, nx),
-        })
+        results.append(
+            {
+                "count": counts.astype(np.int64),
+                "density": means[0],
+                "log_radius": means[1],
+                "log_spread": np.maximum(means[2] - means[1] ** 2, 0.0),
+                "window_a": means[3],
+                "window_b": means[4],
+                "window_factor": window_variance_factor(ny, nx),
+            }
+        )
     return results
 
 
@@ -210,7 +213,12 @@ def binned_spectrum(surface, order=1, per_decade=10):
         levelled = detrend(surface, order=order)
         frequencies, density, parseval = periodogram(levelled.heights, surface.spacing[0])
         centres, means, counts = log_bins(frequencies, density, per_decade)
-        return {"frequency": centres.tolist(), "density": means.tolist(), "count": counts.tolist(), "parseval": parseval}
+        return {
+            "frequency": centres.tolist(),
+            "density": means.tolist(),
+            "count": counts.tolist(),
+            "parseval": parseval,
+        }
     ny, nx = surface.heights.shape
     step = max(1 / (nx * surface.spacing[0]), 1 / (ny * surface.spacing[1]))
     field, power = windowed_map(surface, order)

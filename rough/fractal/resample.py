@@ -53,8 +53,9 @@ def resample(surface, spacing, fill=False):
         new_spacing.append(old / float(ratio))
     if invalid.any():
         heights = np.where(_nearest_invalid(invalid, surface.spacing, new_spacing, heights.shape), np.nan, heights)
-    return surface.derive("resample", {"spacing": new_spacing, "filled": bool(invalid.any())},
-                          heights=heights, spacing=tuple(new_spacing))
+    return surface.derive(
+        "resample", {"spacing": new_spacing, "filled": bool(invalid.any())}, heights=heights, spacing=tuple(new_spacing)
+    )
 
 
 def _ratio(old, new):
@@ -64,8 +65,10 @@ def _ratio(old, new):
     if abs(float(ratio) - old / new) > 1e-9 * old / new:
         raise InputError(f"cannot resample {old:g} m to {new:g} m exactly with a ratio of small integers")
     if ratio.numerator > MAX_DENOMINATOR:
-        raise InputError(f"cannot refine {old:g} m to {new:g} m in one step (more than {MAX_DENOMINATOR}×); "
-                         "resample in steps, or synthesise the fine scales")
+        raise InputError(
+            f"cannot refine {old:g} m to {new:g} m in one step (more than {MAX_DENOMINATOR}×); "
+            "resample in steps, or synthesise the fine scales"
+        )
     return ratio
 
 

@@ -82,16 +82,32 @@ def rose(surface, step=10.0, width=None, band=None, resolution=None, order=1, sa
     refuse_flat(field, surface.heights)
     transform = fft.rfft2(field, workers=-1)
     count = round(180 / step)
-    sectors = sector_spectra(field, power, surface.spacing, low, high, frequency_step,
-                             (0.0, math.radians(step), count, math.radians(width)), transform=transform)
+    sectors = sector_spectra(
+        field,
+        power,
+        surface.spacing,
+        low,
+        high,
+        frequency_step,
+        (0.0, math.radians(step), count, math.radians(width)),
+        transform=transform,
+    )
     fits = [_sector_fit(rings, resolution) for rings in sectors]
     at_edge = sum(fit["at_edge"] for fit in fits)
     if at_edge:
         warn_at_edge(f" in {at_edge} of {count} sectors", "Ds at 2 or 3")
     angles = [k * step for k in range(count)]
     principal = _principal_direction(angles, fits)
-    along = sector_spectra(field, power, surface.spacing, low, high, frequency_step,
-                           (math.radians(principal), math.pi / 2, 2, math.radians(width)), transform=transform)
+    along = sector_spectra(
+        field,
+        power,
+        surface.spacing,
+        low,
+        high,
+        frequency_step,
+        (math.radians(principal), math.pi / 2, 2, math.radians(width)),
+        transform=transform,
+    )
     del field, transform
     levelled = detrend(surface, order=order)
     str_ratio = autocorrelation_lengths(levelled)[1]
@@ -106,7 +122,9 @@ def rose(surface, step=10.0, width=None, band=None, resolution=None, order=1, sa
         largest_sector=angles[int(np.argmax([f["amplitude"] for f in fits]))],
         principal=_sector_fit(along[0], resolution),
         perpendicular=_sector_fit(along[1], resolution),
-        isotropy_p_value=_flatness(fits) if width <= step + 1e-9 else {"fractal_dimension": None, "amplitude_coefficient": None},
+        isotropy_p_value=_flatness(fits)
+        if width <= step + 1e-9
+        else {"fractal_dimension": None, "amplitude_coefficient": None},
         Str=str_ratio,
         Std=texture_direction(levelled),
         band=(float(low), float(high)),
@@ -119,7 +137,9 @@ def rose(surface, step=10.0, width=None, band=None, resolution=None, order=1, sa
 
 def _sector_fit(rings, resolution):
     if rings["count"].size < 4:
-        raise InputError(f"a sector holds only {rings['count'].size} frequency rings in the band; use wider sectors (--width) or a wider band")
+        raise InputError(
+            f"a sector holds only {rings['count'].size} frequency rings in the band; use wider sectors (--width) or a wider band"
+        )
     return ring_fit(rings, resolution)
 
 
@@ -142,7 +162,11 @@ def _flatness(fits):
     result = {}
     for key, values, errors in (
         ("fractal_dimension", [f["dimension"] for f in fits], [f["dimension_error"] for f in fits]),
-        ("amplitude_coefficient", np.log([f["amplitude"] for f in fits]), [f["amplitude_error"] / f["amplitude"] for f in fits]),
+        (
+            "amplitude_coefficient",
+            np.log([f["amplitude"] for f in fits]),
+            [f["amplitude_error"] / f["amplitude"] for f in fits],
+        ),
     ):
         values, weights = np.asarray(values), 1.0 / np.asarray(errors) ** 2
         mean = np.sum(weights * values) / weights.sum()

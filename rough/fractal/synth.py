@@ -48,16 +48,26 @@ def synthesize_profile(points, spacing, dimension, amplitude=None, rq=None, reso
     seed = _seed(seed)
     generator = np.random.Generator(np.random.PCG64(np.random.SeedSequence(seed)))
     spectrum = _white_profile_spectrum(points, generator)
-    spectrum *= _profile_filter(points, spacing, beta, model.prefactor(amplitude or 1.0, dimension, resolution),
-                                rolloff=rolloff)
+    spectrum *= _profile_filter(
+        points, spacing, beta, model.prefactor(amplitude or 1.0, dimension, resolution), rolloff=rolloff
+    )
     heights = _scaled(np.fft.irfft(spectrum, points), rq)
-    parameters = _parameters(points=points, spacing=spacing, dimension=dimension, amplitude=amplitude, rq=rq,
-                             resolution=resolution, seed=seed, rolloff=rolloff)
+    parameters = _parameters(
+        points=points,
+        spacing=spacing,
+        dimension=dimension,
+        amplitude=amplitude,
+        rq=rq,
+        resolution=resolution,
+        seed=seed,
+        rolloff=rolloff,
+    )
     return _surface(heights, (spacing,), parameters)
 
 
-def synthesize_map(points, spacing, dimension, amplitude=None, rq=None, resolution=None, seed=None, anisotropy=None,
-                   rolloff=None):
+def synthesize_map(
+    points, spacing, dimension, amplitude=None, rq=None, resolution=None, seed=None, anisotropy=None, rolloff=None
+):
     """A fractal map of ``points = (nx, ny)`` at ``spacing = (dx, dy)`` with surface
     dimension Ds (2-3) and the profile-equivalent amplitude coefficient ``amplitude``
     (or the RMS height ``rq``). ``anisotropy = (Ds1, C1, Ds2, C2, angle)`` gives Ds and
@@ -86,13 +96,23 @@ def synthesize_map(points, spacing, dimension, amplitude=None, rq=None, resoluti
         shape = {"dimension": dimension, "amplitude": amplitude}
     else:
         shape = {"anisotropy": [*anisotropy[:4], math.degrees(anisotropy[4])]}
-    parameters = _parameters(points=[nx, ny], spacing=[dx, dy], **shape, rq=rq, resolution=resolution, seed=seed,
-                             rolloff=rolloff)
+    parameters = _parameters(
+        points=[nx, ny], spacing=[dx, dy], **shape, rq=rq, resolution=resolution, seed=seed, rolloff=rolloff
+    )
     return _surface(heights, (dx, dy), parameters)
 
 
-def synthesize_fragments(points, spacing, dimension, amplitude=None, rq=None, resolution=None, seed=None,
-                         fragment=PAPER_FRAGMENT, as_printed=False):
+def synthesize_fragments(
+    points,
+    spacing,
+    dimension,
+    amplitude=None,
+    rq=None,
+    resolution=None,
+    seed=None,
+    fragment=PAPER_FRAGMENT,
+    as_printed=False,
+):
     """The paper's method: ``fragment``-point syntheses (each periodic, with no
     wavelength longer than the fragment), each shifted to start where the previous
     one ended. ``as_printed`` also applies the printed (k+1) index shift."""
@@ -112,11 +132,23 @@ def synthesize_fragments(points, spacing, dimension, amplitude=None, rq=None, re
         end = piece[-1]
         pieces.append(piece)
     heights = _scaled(np.concatenate(pieces)[:points], rq)
-    log.warning("fragments of %d points (%.4g mm) drop every wavelength longer than a fragment: the profile's Rq "
-                "falls well short of eq. (2) (MATH §2.5); use the default whole-length synthesis", fragment,
-                fragment * spacing * 1e3)
-    parameters = _parameters(points=points, spacing=spacing, dimension=dimension, amplitude=amplitude, rq=rq,
-                             resolution=resolution, seed=seed, fragments=fragment, as_printed=as_printed)
+    log.warning(
+        "fragments of %d points (%.4g mm) drop every wavelength longer than a fragment: the profile's Rq "
+        "falls well short of eq. (2) (MATH §2.5); use the default whole-length synthesis",
+        fragment,
+        fragment * spacing * 1e3,
+    )
+    parameters = _parameters(
+        points=points,
+        spacing=spacing,
+        dimension=dimension,
+        amplitude=amplitude,
+        rq=rq,
+        resolution=resolution,
+        seed=seed,
+        fragments=fragment,
+        as_printed=as_printed,
+    )
     return _surface(heights, (spacing,), parameters)
 
 
@@ -236,8 +268,13 @@ def _title(parameters, ndim):
     seed = parameters["seed"]
     if "anisotropy" in parameters:
         ds1, c1, ds2, c2, angle = parameters["anisotropy"]
-        return (f"synthetic anisotropic fractal, Ds = {ds1:g} and C = {format_length(c1)} along {angle:g}°, "
-                f"Ds = {ds2:g} and C = {format_length(c2)} along {(angle + 90) % 180:g}°, seed {seed}")
-    amount = (f"{'Rq' if ndim == 1 else 'Sq'} {format_length(parameters['rq'])}" if "rq" in parameters
-              else f"C {format_length(parameters['amplitude'])}")
+        return (
+            f"synthetic anisotropic fractal, Ds = {ds1:g} and C = {format_length(c1)} along {angle:g}°, "
+            f"Ds = {ds2:g} and C = {format_length(c2)} along {(angle + 90) % 180:g}°, seed {seed}"
+        )
+    amount = (
+        f"{'Rq' if ndim == 1 else 'Sq'} {format_length(parameters['rq'])}"
+        if "rq" in parameters
+        else f"C {format_length(parameters['amplitude'])}"
+    )
     return f"synthetic fractal, {'D' if ndim == 1 else 'Ds'} = {parameters['dimension']:g}, {amount}, seed {seed}"

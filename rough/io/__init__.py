@@ -58,8 +58,18 @@ BOMB_RATIO, BOMB_FLOOR = 1000, 64 << 20  # past 64 MB unpacked, a ratio over 100
 
 # What a malformed file makes the parsers raise; read() turns these into FormatError.
 _PARSE_ERRORS = (
-    ValueError, TypeError, KeyError, IndexError, struct.error, zipfile.BadZipFile,
-    xml.etree.ElementTree.ParseError, UnicodeError, EOFError, OverflowError, zlib.error, SyntaxError,
+    ValueError,
+    TypeError,
+    KeyError,
+    IndexError,
+    struct.error,
+    zipfile.BadZipFile,
+    xml.etree.ElementTree.ParseError,
+    UnicodeError,
+    EOFError,
+    OverflowError,
+    zlib.error,
+    SyntaxError,
     tokenize.TokenError,
 )
 
@@ -183,7 +193,9 @@ def gunzip(data, limit=MAX_UNPACKED_BYTES):
         total += len(part)
         consumed = len(data) - len(pending) - len(unpacker.unused_data)
         if total > limit or (total > BOMB_FLOOR and total > BOMB_RATIO * max(consumed, 1)):
-            raise FormatError(f"gzip data unpack to more than {total >> 20} MB from {consumed} bytes; refusing (a gzip bomb?)")
+            raise FormatError(
+                f"gzip data unpack to more than {total >> 20} MB from {consumed} bytes; refusing (a gzip bomb?)"
+            )
     if not unpacker.eof:
         raise FormatError("truncated gzip data")
     return b"".join(parts)

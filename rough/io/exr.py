@@ -159,4 +159,3 @@ def _double(header, key, default=None):
     if not np.isfinite(value) or (key.endswith("Real") and value <= 0):
         raise FormatError(f"EXR attribute {key} is not a usable length: {value}")
     return value
-

@@ -31,7 +31,9 @@ def read(data, options):
     count = int(np.prod(shape, dtype=object))
     available = len(data) - stream.tell()
     if count * dtype.itemsize > available:
-        raise FormatError(f"NPY header declares {'×'.join(map(str, shape))} values of {dtype.itemsize} bytes; the file holds {available} bytes")
+        raise FormatError(
+            f"NPY header declares {'×'.join(map(str, shape))} values of {dtype.itemsize} bytes; the file holds {available} bytes"
+        )
     if options.spacing is None:
         raise FormatError("NPY files carry no spacing; give it with --spacing (e.g. --spacing 1um)")
     heights = np.frombuffer(data, dtype, count=count, offset=stream.tell())

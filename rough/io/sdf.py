@@ -51,13 +51,15 @@ def _ascii(text):
         raise FormatError("SDF header is not closed by a '*' line")
     header = _checked(header)
     body = []
-    for line in lines[position + 1:]:
+    for line in lines[position + 1 :]:
         if line.strip() == "*":
             break
         body.extend(line.split())
     count = header["NumPoints"] * header["NumProfiles"]
     if len(body) != count:
-        raise FormatError(f"SDF declares {header['NumPoints']}×{header['NumProfiles']} points but holds {len(body)} values")
+        raise FormatError(
+            f"SDF declares {header['NumPoints']}×{header['NumProfiles']} points but holds {len(body)} values"
+        )
     values = np.array([np.nan if item.upper() == "BAD" else float(item) for item in body])
     return header, values
 
@@ -66,10 +68,25 @@ def _binary(data):
     if len(data) < BINARY_HEADER.size:
         raise FormatError("binary SDF file shorter than its 81-byte header")
     fields = BINARY_HEADER.unpack_from(bytes(data[: BINARY_HEADER.size]))
-    names = ("version", "ManufacID", "CreateDate", "ModDate", "NumPoints", "NumProfiles",
-             "Xscale", "Yscale", "Zscale", "Zresolution", "Compression", "DataType", "CheckType")
-    header = {name: (value.decode("latin-1").strip("\0 ") if isinstance(value, bytes) else value)
-              for name, value in zip(names, fields)}
+    names = (
+        "version",
+        "ManufacID",
+        "CreateDate",
+        "ModDate",
+        "NumPoints",
+        "NumProfiles",
+        "Xscale",
+        "Yscale",
+        "Zscale",
+        "Zresolution",
+        "Compression",
+        "DataType",
+        "CheckType",
+    )
+    header = {
+        name: (value.decode("latin-1").strip("\0 ") if isinstance(value, bytes) else value)
+        for name, value in zip(names, fields)
+    }
     header = _checked(header)
     dtype = np.dtype(DATA_TYPES[header["DataType"]])
     count = header["NumPoints"] * header["NumProfiles"]

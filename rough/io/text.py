@@ -82,7 +82,7 @@ def header_lines(surface):
 
 def _write_rows(stream, columns, heights):
     for start in range(0, len(heights), 65536):
-        chunk = [c[start: start + 65536] for c in (*columns, heights)]
+        chunk = [c[start : start + 65536] for c in (*columns, heights)]
         rows = ("\t".join(map(repr, values)) for values in zip(*(c.tolist() for c in chunk)))
         stream.write(("\n".join(rows) + "\n").encode("ascii"))
 
@@ -116,7 +116,9 @@ def _columns(lines, options):
     if count == 3:
         return _grid(table, units, settings, body, delimiter)
     heights = table * metres_per(default_unit)
-    return _from_spacing(heights if len(heights) > 1 else heights[0], options, settings, Units(default_unit, default_unit))
+    return _from_spacing(
+        heights if len(heights) > 1 else heights[0], options, settings, Units(default_unit, default_unit)
+    )
 
 
 def _dektak(lines, options):
@@ -129,7 +131,7 @@ def _dektak(lines, options):
     names = [name.strip() for name in lines[start + 1].split(",")]
     if len(names) < 2:
         raise FormatError("Dektak CSV: no column names after 'Scan Data'")
-    body = lines[start + 2:]
+    body = lines[start + 2 :]
     table = _numbers(body, ",", (0, 1))
     x_unit, z_unit = _unit_of(names[0], "um"), _unit_of(names[1], "um")
     metadata = {"instrument": "Dektak stylus profiler"}
@@ -174,7 +176,9 @@ def _key_value_matrix(lines, options):
     table = _numbers(lines[position:], None, None)
     rows, columns = header.get("h"), header.get("w")
     if rows is not None and columns is not None and (int(rows), int(columns)) != table.shape:
-        raise FormatError(f"header says {rows} rows × {columns} columns, the data have {table.shape[0]} × {table.shape[1]}")
+        raise FormatError(
+            f"header says {rows} rows × {columns} columns, the data have {table.shape[0]} × {table.shape[1]}"
+        )
     if "pixel size" in header:
         pixel, xy_unit = _length_with_unit(header["pixel size"], "pixel size")
         spacing = (pixel, pixel)
@@ -400,4 +404,3 @@ def _provenance(settings, units):
 
 def _floats(text):
     return [float(value) for value in text.split()]
-

@@ -45,8 +45,16 @@ VENDOR_ID = "urn:x-rough:x3p-vendor:1"
 VENDOR_MEMBER = "vendor/rough.json"
 DATA_TYPES = {"I": "<i2", "L": "<i4", "F": "<f4", "D": "<f8"}
 # What zipfile raises for damaged or unusual archives (bz2 raises OSError, lzma LZMAError)
-ZIP_ERRORS = (zipfile.BadZipFile, zipfile.LargeZipFile, NotImplementedError, RuntimeError, OSError, EOFError, zlib.error,
-              lzma.LZMAError)
+ZIP_ERRORS = (
+    zipfile.BadZipFile,
+    zipfile.LargeZipFile,
+    NotImplementedError,
+    RuntimeError,
+    OSError,
+    EOFError,
+    zlib.error,
+    lzma.LZMAError,
+)
 MAX_POINTS = 1 << 31
 MAX_XML_BYTES = 1 << 31
 MAX_SIDE_BYTES = 1 << 26
@@ -133,7 +141,8 @@ def write(surface, stream):
 
 def _find_main(archive):
     candidates = [
-        name for name in archive.namelist()
+        name
+        for name in archive.namelist()
         if (name == "main.xml" or name.endswith("/main.xml")) and not name.startswith("__MACOSX/")
     ]
     if not candidates:
@@ -156,11 +165,11 @@ def _member(archive, name, data, limit=None, expected=None, check_crc=True):
         raise FormatError(f"{name} is {info.file_size} bytes, more than rough reads ({limit})")
     if info.compress_type == zipfile.ZIP_STORED and not info.flag_bits & 0x1:
         view = memoryview(data)
-        header = bytes(view[info.header_offset: info.header_offset + 30])
+        header = bytes(view[info.header_offset : info.header_offset + 30])
         if len(header) < 30 or header[:4] != b"PK\x03\x04":
             raise FormatError(f"damaged zip: no local header for {name}")
         start = info.header_offset + 30 + sum(struct.unpack("<HH", header[26:30]))
-        content = view[start: start + info.file_size]
+        content = view[start : start + info.file_size]
         if len(content) != info.file_size:
             raise FormatError(f"truncated archive: {name} is cut short")
         if check_crc and zlib.crc32(content) != info.CRC:
@@ -270,7 +279,9 @@ def _binary_records(archive, prefix, root, data, fields, count, verify):
     link = _text(root, "Record3/DataLink/PointDataLink", required=True)
     record = np.dtype(fields)
     stated = _text(root, "Record3/DataLink/MD5ChecksumPointData")
-    payload = _member(archive, f"{prefix}{link}", data, expected=count * record.itemsize, check_crc=not (verify and stated))
+    payload = _member(
+        archive, f"{prefix}{link}", data, expected=count * record.itemsize, check_crc=not (verify and stated)
+    )
     actual = hashlib.md5(payload).hexdigest()
     _check(verify, _md5_problem(actual, stated, link))
     records = np.frombuffer(payload, dtype=record)
@@ -279,7 +290,12 @@ def _binary_records(archive, prefix, root, data, fields, count, verify):
     if valid_link is None:
         return records, None, verified
     packed = _member(archive, f"{prefix}{valid_link}", data, limit=MAX_POINTS // 8 + 1)
-    _check(verify, _md5_problem(hashlib.md5(packed).hexdigest(), _text(root, "Record3/DataLink/MD5ChecksumValidPoints"), valid_link))
+    _check(
+        verify,
+        _md5_problem(
+            hashlib.md5(packed).hexdigest(), _text(root, "Record3/DataLink/MD5ChecksumValidPoints"), valid_link
+        ),
+    )
     if len(packed) < (count + 7) // 8:
         raise FormatError(f"{valid_link} holds {len(packed)} bytes, too few for {count} points")
     valid = np.unpackbits(np.frombuffer(packed, np.uint8), count=count, bitorder="little").astype(bool)
@@ -337,7 +353,9 @@ def _grid(name, axis, records, valid, n, nx, ny):
     expected = along[0] + step * np.arange(n)
     full = expected[np.newaxis, :] if name == "CX" else expected[:, np.newaxis]
     if not step > 0 or np.nanmax(np.abs(coordinates - full)) > 1e-6 * step:
-        raise FormatError(f"irregular grid: the absolute {name} coordinates are not evenly spaced (rough needs a regular grid)")
+        raise FormatError(
+            f"irregular grid: the absolute {name} coordinates are not evenly spaced (rough needs a regular grid)"
+        )
     return float(step), float(along[0])
 
 
@@ -384,7 +402,6 @@ def _digest_of(heights, payload):
     return digest if ref() is heights else hashlib.md5(payload).hexdigest()
 
 
-
 def _store(archive, name, content, align=None):
     info = zipfile.ZipInfo(name, date_time=_zip_time())
     info.compress_type = zipfile.ZIP_STORED
@@ -413,7 +430,9 @@ def _main_xml(surface, data_md5, mask_md5):
             _pad(surface.origin, 0.0),
         )
     )
-    probing = m.get("probing_type") if m.get("probing_type") in ("Contacting", "NonContacting", "Software") else "Software"
+    probing = (
+        m.get("probing_type") if m.get("probing_type") in ("Contacting", "NonContacting", "Software") else "Software"
+    )
     fields = {
         "manufacturer": m.get("instrument_manufacturer") or m.get("instrument") or "not available",
         "model": m.get("instrument_model") or "not available",
@@ -426,7 +445,8 @@ def _main_xml(surface, data_md5, mask_md5):
     creator = f"<Creator>{escape(m['creator'])}</Creator>" if m.get("creator") else ""
     valid = (
         f"<ValidPointsLink>bindata/valid.bin</ValidPointsLink><MD5ChecksumValidPoints>{mask_md5}</MD5ChecksumValidPoints>"
-        if mask_md5 else ""
+        if mask_md5
+        else ""
     )
     nx, ny = (*surface.points, 1)[:2]
     return (

@@ -29,9 +29,22 @@ KEEP = ("roughness", "waviness", "form")
 log = logging.getLogger("rough")
 
 __all__ = [
-    "AREAL", "KEEP", "PROFILE", "Feature", "amplitude_density", "areal_parameters", "detect_features", "detrend",
-    "mean_line", "parameters", "polynomial_form", "profile_parameters", "remove_form", "rq_versus_length",
-    "split", "transmission",
+    "AREAL",
+    "KEEP",
+    "PROFILE",
+    "Feature",
+    "amplitude_density",
+    "areal_parameters",
+    "detect_features",
+    "detrend",
+    "mean_line",
+    "parameters",
+    "polynomial_form",
+    "profile_parameters",
+    "remove_form",
+    "rq_versus_length",
+    "split",
+    "transmission",
 ]
 
 
@@ -50,13 +63,14 @@ def detrend(surface, order=2, cutoff=None, keep="roughness", ends="trim"):
         raise InputError("the waviness needs a cut-off (--cutoff)")
     if keep == "form":
         form = polynomial_form(surface, order)
-        return surface.derive("detrend", {"order": order, "keep": "form"}, heights=np.where(np.isnan(surface.heights), np.nan, form))
+        return surface.derive(
+            "detrend", {"order": order, "keep": "form"}, heights=np.where(np.isnan(surface.heights), np.nan, form)
+        )
     levelled = remove_form(surface, order)
     return levelled if cutoff is None else split(levelled, cutoff, keep, ends)
 
 
-def parameters(surface, cutoff=None, ends="trim", sampling_lengths=5, slope="2point", along=None,
-               jrc_spacing=0.5e-3):
+def parameters(surface, cutoff=None, ends="trim", sampling_lengths=5, slope="2point", along=None, jrc_spacing=0.5e-3):
     """ISO parameters of a profile (Ra … JRC) or map (Sa … Std), in SI units, on the
     data as given with the mean removed, or on the roughness at ``cutoff``.
 
@@ -107,8 +121,11 @@ def _profiles_of_map(surface, along, sampling_lengths, slope, jrc_spacing):
         raise InputError(f"along must be x or y, not {along!r}")
     rows = surface.heights if along == "x" else surface.heights.T
     spacing = surface.spacing[0 if along == "x" else 1]
-    each = [profile_parameters(Surface(row, (spacing,)), sampling_lengths, slope, jrc_spacing)
-            for row in rows if np.count_nonzero(~np.isnan(row)) > 1]
+    each = [
+        profile_parameters(Surface(row, (spacing,)), sampling_lengths, slope, jrc_spacing)
+        for row in rows
+        if np.count_nonzero(~np.isnan(row)) > 1
+    ]
     if not each:
         raise InputError(f"no profile along {along} has two valid points")
     combined = {}

@@ -55,7 +55,7 @@ def detect_features(surface, cutoff=2.5e-3, k=2.0, extension=0.3, polarity="both
     centred = dataclasses.replace(surface, heights=z)
     line = mean_line(centred, cutoff)
     margin = int(np.ceil(cutoff / 2 / surface.spacing[0]))
-    high = (z - line)[margin: z.size - margin]
+    high = (z - line)[margin : z.size - margin]
     rq_hf = float(np.sqrt(np.nanmean(high**2))) if np.isfinite(high).any() else np.nan
     threshold = k * rq_hf
     x = surface.positions(0)
@@ -63,7 +63,11 @@ def detect_features(surface, cutoff=2.5e-3, k=2.0, extension=0.3, polarity="both
     found = []
     for kind in kinds:
         signed = line if kind == "peaks" else -line
-        spans = _runs_above(signed, threshold, extension) if mode == "B" else _extremes_above(signed, x, threshold, extension)
+        spans = (
+            _runs_above(signed, threshold, extension)
+            if mode == "B"
+            else _extremes_above(signed, x, threshold, extension)
+        )
         found += [_describe(kind, signed, x, start, stop) for start, stop in spans]
     found.sort(key=lambda feature: feature.position)
     return found, {"rq_high_frequency": rq_hf, "threshold": threshold}
@@ -103,6 +107,13 @@ def _extremes_above(signed, x, threshold, extension):
 def _describe(kind, signed, x, start, stop):
     part = signed[start:stop]
     top = start + int(np.nanargmax(part))
-    base = max(np.nanmin(signed[start: top + 1]), np.nanmin(signed[top:stop]))
+    base = max(np.nanmin(signed[start : top + 1]), np.nanmin(signed[top:stop]))
     sign = 1.0 if kind == "peaks" else -1.0
-    return Feature(kind[:-1], float(x[top]), float(x[start]), float(x[stop - 1]), sign * float(signed[top]), float(signed[top] - base))
+    return Feature(
+        kind[:-1],
+        float(x[top]),
+        float(x[start]),
+        float(x[stop - 1]),
+        sign * float(signed[top]),
+        float(signed[top] - base),
+    )

@@ -78,14 +78,24 @@ def split(surface, cutoff, keep="roughness", ends="trim"):
         raise InputError(f"ends must be one of {', '.join(ENDS)}, not {ends!r}")
     line = mean_line(surface, cutoff)
     result = surface.heights - line if keep == "roughness" else line
-    filtered = surface.derive("filter", {"standard": "ISO 16610-21" if surface.is_profile else "ISO 16610-61",
-                                         "cutoff": cutoff, "keep": keep, "ends": ends}, heights=result)
+    filtered = surface.derive(
+        "filter",
+        {
+            "standard": "ISO 16610-21" if surface.is_profile else "ISO 16610-61",
+            "cutoff": cutoff,
+            "keep": keep,
+            "ends": ends,
+        },
+        heights=result,
+    )
     if ends == "correct":
         return filtered
     margins = [int(np.ceil(cutoff / 2 / d - 1e-9)) for d in filtered.spacing]
     if any(n - 2 * m < 2 for n, m in zip(filtered.points, margins)):
-        raise InputError(f"the data are too short for a cut-off of {format_length(cutoff)} once λc/2 is trimmed "
-                         "at each end (use --ends correct or a shorter cut-off)")
+        raise InputError(
+            f"the data are too short for a cut-off of {format_length(cutoff)} once λc/2 is trimmed "
+            "at each end (use --ends correct or a shorter cut-off)"
+        )
     index = tuple(slice(m, n - m) for n, m in zip(reversed(filtered.points), reversed(margins)))
     origin = tuple(o + m * d for o, m, d in zip(filtered.origin, margins, filtered.spacing))
     return dataclasses.replace(filtered, heights=filtered.heights[index], origin=origin)
@@ -96,8 +106,12 @@ def _check_cutoff(surface, cutoff):
         raise InputError(f"the cut-off must be a positive length, not {cutoff!r}")
     shortest = min(n * d for n, d in zip(surface.points, surface.spacing))
     if cutoff > shortest:
-        raise InputError(f"the cut-off {format_length(cutoff)} is longer than the data ({format_length(shortest)}); "
-                         "the filter needs at least one cut-off length")
+        raise InputError(
+            f"the cut-off {format_length(cutoff)} is longer than the data ({format_length(shortest)}); "
+            "the filter needs at least one cut-off length"
+        )
     if cutoff < 2 * max(surface.spacing):
-        raise InputError(f"the cut-off {format_length(cutoff)} is shorter than two samples "
-                         f"({format_length(max(surface.spacing))} spacing)")
+        raise InputError(
+            f"the cut-off {format_length(cutoff)} is shorter than two samples "
+            f"({format_length(max(surface.spacing))} spacing)"
+        )

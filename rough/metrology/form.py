@@ -43,7 +43,8 @@ def form_factors(surface, order=2):
     weights = None if complete else valid.astype(np.float64)
     weighted_x = {
         (i, k): np.full(ny, along_x[:, i] @ along_x[:, k]) if complete else weights @ (along_x[:, i] * along_x[:, k])
-        for i in range(order + 1) for k in range(i, order + 1)
+        for i in range(order + 1)
+        for k in range(i, order + 1)
     }
     projected = (heights if complete else np.where(valid, heights, 0.0)) @ along_x
     gram = np.empty((len(terms), len(terms)))

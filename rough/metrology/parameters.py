@@ -93,8 +93,14 @@ def amplitude(values):
     rq = math.sqrt(squared.mean())
     skew = float(np.mean(squared * centred_values)) / rq**3 if rq > 0 else math.nan
     kurtosis = float(np.mean(squared * squared)) / rq**4 if rq > 0 else math.nan
-    return {"a": float(np.abs(centred_values).mean()), "q": rq, "sk": skew, "ku": kurtosis,
-            "p": float(centred_values.max()), "v": 0.0 - float(centred_values.min())}
+    return {
+        "a": float(np.abs(centred_values).mean()),
+        "q": rq,
+        "sk": skew,
+        "ku": kurtosis,
+        "p": float(centred_values.max()),
+        "v": 0.0 - float(centred_values.min()),
+    }
 
 
 def slopes(heights, spacing, method="2point", axis=-1):
@@ -126,8 +132,14 @@ def profile_parameters(surface, sampling_lengths=5, slope="2point", jrc_spacing=
     slope_values = slopes(z, dx, slope)
     z2 = _z2(surface, jrc_spacing)
     return {
-        "Ra": moments["a"], "Rq": moments["q"], "Rsk": moments["sk"], "Rku": moments["ku"],
-        "Rp": rp, "Rv": rv, "Rz": rz, "Rt": moments["p"] + moments["v"],
+        "Ra": moments["a"],
+        "Rq": moments["q"],
+        "Rsk": moments["sk"],
+        "Rku": moments["ku"],
+        "Rp": rp,
+        "Rv": rv,
+        "Rz": rz,
+        "Rt": moments["p"] + moments["v"],
         "RSm": mean_element_width(levels, dx, rz, length / sampling_lengths),
         "Rdq": _rms(slope_values),
         "peak_density": peak_count(levels, peak_band * rz) / length,
@@ -149,8 +161,13 @@ def areal_parameters(surface, slope="2point", threshold=0.2):
     squared = gx**2 + gy**2
     sal, str_ratio = autocorrelation_lengths(surface, threshold)
     return {
-        "Sa": moments["a"], "Sq": moments["q"], "Ssk": moments["sk"], "Sku": moments["ku"],
-        "Sp": moments["p"], "Sv": moments["v"], "Sz": moments["p"] + moments["v"],
+        "Sa": moments["a"],
+        "Sq": moments["q"],
+        "Ssk": moments["sk"],
+        "Sku": moments["ku"],
+        "Sp": moments["p"],
+        "Sv": moments["v"],
+        "Sz": moments["p"] + moments["v"],
         "Sdq": float(math.sqrt(np.nanmean(squared))) if np.isfinite(squared).any() else math.nan,
         "Sdr": float(100.0 * np.nanmean(np.sqrt(1.0 + squared) - 1.0)) if np.isfinite(squared).any() else math.nan,
         "Sal": sal,
@@ -258,8 +275,8 @@ def autocorrelation(surface):
         mask = fft.rfft2(valid.astype(np.float64), shape, workers=-1)
         pairs = np.rint(fft.irfft2(mask * mask.conj(), shape, workers=-1))
     hy, hx = ny // 2, nx // 2
-    rows = np.r_[shape[0] - hy: shape[0], 0: hy + 1]
-    columns = np.r_[shape[1] - hx: shape[1], 0: hx + 1]
+    rows = np.r_[shape[0] - hy : shape[0], 0 : hy + 1]
+    columns = np.r_[shape[1] - hx : shape[1], 0 : hx + 1]
     with np.errstate(invalid="ignore", divide="ignore"):
         acf = products[np.ix_(rows, columns)] / pairs[np.ix_(rows, columns)]
         acf = acf / acf[hy, hx]
@@ -297,8 +314,12 @@ def autocorrelation_lengths(surface, threshold=0.2, directions=360):
     fastest = float(np.nanmin(decay)) if np.isfinite(decay).any() else math.nan
     slowest = float(np.max(decay)) if np.isfinite(decay).all() else math.nan
     if np.isnan(slowest) and np.isfinite(fastest):
-        log.warning("Str is undefined: the autocorrelation stays above %g out to half the map in some direction "
-                    "(the texture runs longer than that); Str < %.3g", threshold, fastest / np.max(reaches[np.isnan(decay)]))
+        log.warning(
+            "Str is undefined: the autocorrelation stays above %g out to half the map in some direction "
+            "(the texture runs longer than that); Str < %.3g",
+            threshold,
+            fastest / np.max(reaches[np.isnan(decay)]),
+        )
     return fastest, fastest / slowest if slowest > 0 else math.nan
 
 

@@ -38,8 +38,11 @@ def rq_versus_length(surface):
         counts.append(len(windows))
     slope = float(np.polyfit(np.log(lengths), np.log(rms), 1)[0])
     return {
-        "length": lengths, "Rq" if surface.is_profile else "Sq": rms, "windows": counts,
-        "hurst": slope, "fractal_dimension": (2.0 if surface.is_profile else 3.0) - slope,
+        "length": lengths,
+        "Rq" if surface.is_profile else "Sq": rms,
+        "windows": counts,
+        "hurst": slope,
+        "fractal_dimension": (2.0 if surface.is_profile else 3.0) - slope,
     }
 
 

@@ -136,8 +136,10 @@ def _check_cost(heights, radius, spacing):
     seconds = heights.size * kernel_points * SECONDS_PER_COMPARISON[heights.ndim]
     size = f"a {radius * 1e3:g} mm tip spans about {kernel_points:.0f} samples of this surface"
     if seconds > MAX_SECONDS:
-        raise InputError(f"{size}: one pass would take about {seconds / 3600:.0f} h; "
-                         "resample the surface to a coarser spacing first")
+        raise InputError(
+            f"{size}: one pass would take about {seconds / 3600:.0f} h; resample the surface to a coarser spacing first"
+        )
     if seconds > 10:
-        log.warning(f"{size}: this takes about {seconds:.0f} s per pass "
-                    "(resample to a coarser spacing for a quicker answer)")
+        log.warning(
+            f"{size}: this takes about {seconds:.0f} s per pass (resample to a coarser spacing for a quicker answer)"
+        )

@@ -25,13 +25,35 @@ from .loop import TRACE_FIELDS, Run, Settings, run
 from .track import Track
 
 __all__ = [
-    "MAX_FORCE", "STIFFNESS", "TRACE_FIELDS", "DynamicStylus", "QuasiStatic", "Run", "Settings", "SimulatedHand",
-    "Track", "clamp", "forces", "parse_friction", "run", "simulate", "write_trace",
+    "MAX_FORCE",
+    "STIFFNESS",
+    "TRACE_FIELDS",
+    "DynamicStylus",
+    "QuasiStatic",
+    "Run",
+    "Settings",
+    "SimulatedHand",
+    "Track",
+    "clamp",
+    "forces",
+    "parse_friction",
+    "run",
+    "simulate",
+    "write_trace",
 ]
 
 
-def simulate(track, speed, model=None, friction=None, settings=None, press=PRESS, hand_mass=HAND_MASS,
-             hand_damping=HAND_DAMPING, lateral_stiffness=None):
+def simulate(
+    track,
+    speed,
+    model=None,
+    friction=None,
+    settings=None,
+    press=PRESS,
+    hand_mass=HAND_MASS,
+    hand_damping=HAND_DAMPING,
+    lateral_stiffness=None,
+):
     """Stroke ``track`` once at ``speed`` (m/s) with the simulated hand, starting at
     rest on the surface under its own press; returns the loop's :class:`Run`. The
     duration defaults to one pass over the track; the run is unpaced unless
@@ -41,8 +63,16 @@ def simulate(track, speed, model=None, friction=None, settings=None, press=PRESS
     if settings.duration is None:
         settings = Settings(**{**settings.__dict__, "duration": track.length / speed})
     start = track.at(track.start)[0] - press / model.stiffness
-    hand = SimulatedHand(speed, track.start, start, settings.period, press=press, mass=hand_mass,
-                         damping=hand_damping, lateral_stiffness=lateral_stiffness)
+    hand = SimulatedHand(
+        speed,
+        track.start,
+        start,
+        settings.period,
+        press=press,
+        mass=hand_mass,
+        damping=hand_damping,
+        lateral_stiffness=lateral_stiffness,
+    )
     result = run(hand, [track], model, friction, settings)
     result.speed = speed
     return result

@@ -89,7 +89,10 @@ class DynamicStylus:
         p11, p12, p21, p22, g1, g2 = self._flight
         position, velocity = self.position, self.velocity
         for j in range(1, self.substeps + 1):
-            position, velocity = p11 * position + p12 * velocity + g1 * drive, p21 * position + p22 * velocity + g2 * drive
+            position, velocity = (
+                p11 * position + p12 * velocity + g1 * drive,
+                p21 * position + p22 * velocity + g2 * drive,
+            )
             ground = h + surface_rate * j * self.substep
             if position <= ground:
                 self.touching = True

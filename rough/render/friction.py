@@ -97,8 +97,17 @@ class Dahl:
 
 MODELS = {
     "coulomb": (CoulombViscous, {"level": "force", "viscous": "damping"}),
-    "karnopp": (Karnopp, {"static": "force", "coulomb": "force", "viscous": "damping", "band": "speed",
-                          "stiffness": "stiffness", "damping": "damping"}),
+    "karnopp": (
+        Karnopp,
+        {
+            "static": "force",
+            "coulomb": "force",
+            "viscous": "damping",
+            "band": "speed",
+            "stiffness": "stiffness",
+            "damping": "damping",
+        },
+    ),
     "dahl": (Dahl, {"stiffness": "stiffness", "coulomb": "force"}),
 }
 

@@ -23,8 +23,18 @@ class SimulatedHand:
     name = "sim"
     needs_watchdog = False
 
-    def __init__(self, speed, start_x, start_y, period, press=PRESS, mass=HAND_MASS, damping=HAND_DAMPING,
-                 lateral_stiffness=None, lateral_damping=20.0):
+    def __init__(
+        self,
+        speed,
+        start_x,
+        start_y,
+        period,
+        press=PRESS,
+        mass=HAND_MASS,
+        damping=HAND_DAMPING,
+        lateral_stiffness=None,
+        lateral_damping=20.0,
+    ):
         if not (mass > 0 and damping >= 0 and period > 0):
             raise ValueError("the hand needs a positive mass and period and a non-negative damping")
         self.speed, self.press, self.period = float(speed), float(press), float(period)
@@ -33,7 +43,9 @@ class SimulatedHand:
         self.y, self.vy = float(start_y), 0.0
         self.offset, self.offset_velocity = 0.0, 0.0
         self._vertical = zero_order_hold(0.0, damping, mass, period)
-        self._lateral = None if lateral_stiffness is None else zero_order_hold(lateral_stiffness, lateral_damping, mass, period)
+        self._lateral = (
+            None if lateral_stiffness is None else zero_order_hold(lateral_stiffness, lateral_damping, mass, period)
+        )
 
     @property
     def velocity(self):

@@ -97,7 +97,9 @@ class Joystick:
             if self._stopped:
                 return
             for block, force in zip(self.blocks, (fx * self.x_sign, fy * self.y_sign)):
-                self._send(self.pid.constant, {EFFECT_BLOCK_INDEX: block, MAGNITUDE: field.scale(force / self.max_force)})
+                self._send(
+                    self.pid.constant, {EFFECT_BLOCK_INDEX: block, MAGNITUDE: field.scale(force / self.max_force)}
+                )
 
     def emergency_stop(self):
         """Zero the force and stop the effects now (from any thread); later writes are ignored."""
@@ -141,12 +143,16 @@ class Joystick:
             self._send(self.pid.set_effect, self._effect_parameters(block, axis))
             self._send(self.pid.constant, {EFFECT_BLOCK_INDEX: block, MAGNITUDE: 0})
             operation = self.pid.operation
-            self._send(operation, {EFFECT_BLOCK_INDEX: block, _array_usage(operation): _array(operation).choose(OP_START),
-                                   LOOP_COUNT: 1})
+            self._send(
+                operation,
+                {EFFECT_BLOCK_INDEX: block, _array_usage(operation): _array(operation).choose(OP_START), LOOP_COUNT: 1},
+            )
 
     def _create_effect(self):
         create = self.pid.create
-        self._io(self.handle.send_feature_report, create.wire({_array_usage(create): _array(create).choose(CONSTANT_FORCE)}))
+        self._io(
+            self.handle.send_feature_report, create.wire({_array_usage(create): _array(create).choose(CONSTANT_FORCE)})
+        )
         load = self.pid.load
         answer = bytes(self._io(self.handle.get_feature_report, load.id, load.size + (0 if load.id else 1)))
         if not load.id:
@@ -160,8 +166,13 @@ class Joystick:
 
     def _effect_parameters(self, block, axis):
         report = self.pid.set_effect
-        values = {EFFECT_BLOCK_INDEX: block, _array_usage(report): _array(report).choose(CONSTANT_FORCE),
-                  X: int(axis == X), Y: int(axis == Y), DIRECTION_ENABLE: 0}
+        values = {
+            EFFECT_BLOCK_INDEX: block,
+            _array_usage(report): _array(report).choose(CONSTANT_FORCE),
+            X: int(axis == X),
+            Y: int(axis == Y),
+            DIRECTION_ENABLE: 0,
+        }
         for usage in (DURATION, TRIGGER_BUTTON):  # Null: play until stopped; no trigger button
             if usage in report.fields:
                 values[usage] = report.fields[usage].null
@@ -188,8 +199,10 @@ class Joystick:
         for block in self.blocks:
             self._quietly(self.pid.constant, {EFFECT_BLOCK_INDEX: block, MAGNITUDE: 0})
             operation = self.pid.operation
-            self._quietly(operation, {EFFECT_BLOCK_INDEX: block, _array_usage(operation): _array(operation).choose(OP_STOP),
-                                      LOOP_COUNT: 0})
+            self._quietly(
+                operation,
+                {EFFECT_BLOCK_INDEX: block, _array_usage(operation): _array(operation).choose(OP_STOP), LOOP_COUNT: 0},
+            )
 
     def _send(self, report, values):
         written = self._io(self.handle.write, report.wire(values))
@@ -228,7 +241,9 @@ def find_joystick(spec="hid"):
             _, vendor, product = spec.split(":")
             wanted = (int(vendor, 16), int(product, 16))
         except ValueError:
-            raise PidError(f"--device {spec!r}: write hid or hid:VID:PID with hexadecimal IDs, e.g. hid:1209:0001") from None
+            raise PidError(
+                f"--device {spec!r}: write hid or hid:VID:PID with hexadecimal IDs, e.g. hid:1209:0001"
+            ) from None
     candidates = [d for d in hidraw.enumerate() if wanted is None or (d["vendor_id"], d["product_id"]) == wanted]
     refused = []
     for info in candidates:
@@ -244,7 +259,13 @@ def find_joystick(spec="hid"):
             return handle, descriptor, label
         handle.close()
     if refused:
-        raise PidError(f"no force-feedback joystick could be opened: {'; '.join(refused)} (check the hidraw permissions)")
-    what = "no HID device" if not candidates else f"{len(candidates)} HID device(s) but none speaks HID PID (force feedback)"
+        raise PidError(
+            f"no force-feedback joystick could be opened: {'; '.join(refused)} (check the hidraw permissions)"
+        )
+    what = (
+        "no HID device"
+        if not candidates
+        else f"{len(candidates)} HID device(s) but none speaks HID PID (force feedback)"
+    )
     target = "" if wanted is None else f" with ID {wanted[0]:04x}:{wanted[1]:04x}"
     raise PidError(f"no force-feedback joystick found: {what}{target}")

@@ -83,9 +83,13 @@ class Run:
         """Achieved rate (Hz), period jitter p50/p99/max (s), missed deadlines and the
         largest lateness (s); for an unpaced run only the speed against real time."""
         simulated = self.ticks * self.settings.period
-        timing = {"ticks": self.ticks, "simulated_time": simulated, "wall_time": self.wall_time,
-                  "realtime_factor": simulated / self.wall_time if self.wall_time > 0 else math.inf,
-                  "scheduling": self.scheduling}
+        timing = {
+            "ticks": self.ticks,
+            "simulated_time": simulated,
+            "wall_time": self.wall_time,
+            "realtime_factor": simulated / self.wall_time if self.wall_time > 0 else math.inf,
+            "scheduling": self.scheduling,
+        }
         if self.starts is not None and self.starts.size > 2:
             periods = np.diff(self.starts)
             jitter = np.abs(periods - self.settings.period)
@@ -264,7 +268,9 @@ class _Loop:
 
     def result(self):
         columns = np.frombuffer(self.rows, dtype=np.float64).reshape(-1, len(TRACE_FIELDS))
-        trace = np.empty(len(columns), dtype=[(name, np.float64) for name in TRACE_FIELDS[:-1]] + [("contact", np.bool_)])
+        trace = np.empty(
+            len(columns), dtype=[(name, np.float64) for name in TRACE_FIELDS[:-1]] + [("contact", np.bool_)]
+        )
         for index, name in enumerate(TRACE_FIELDS):
             trace[name] = columns[:, index]
         trace["h"][~np.isfinite(trace["h"])] = np.nan
@@ -272,5 +278,16 @@ class _Loop:
             trace["t"] = np.asarray(self.starts[: trace.size]) - self.starts[0]
         starts = np.asarray(self.starts) if self.starts else None
         deadlines = np.asarray(self.deadlines) if self.deadlines else None
-        return Run(trace, self.ticks, self.wall_time, self.settings, starts, deadlines, self.missed, self.switches,
-                   self.ended_by, scheduling=self.scheduling, answer=self.answer)
+        return Run(
+            trace,
+            self.ticks,
+            self.wall_time,
+            self.settings,
+            starts,
+            deadlines,
+            self.missed,
+            self.switches,
+            self.ended_by,
+            scheduling=self.scheduling,
+            answer=self.answer,
+        )

@@ -127,16 +127,26 @@ class PidDescriptor:
         self.joystick = _find(parsed.input_reports, lambda u, a: X in u and Y in u, "an input report with X and Y axes")
         fields = self.joystick.fields
         self.buttons = [fields[usage] for usage in sorted(u for u in fields if u & 0xFFFF0000 == BUTTON_PAGE)]
-        self.set_effect = _find(parsed.output_reports, lambda u, a: CONSTANT_FORCE in a and DURATION in u, "a Set Effect report")
-        self.constant = _find(parsed.output_reports, lambda u, a: MAGNITUDE in u and not (u & OTHER_EFFECT_PARAMETERS),
-                              "a Set Constant Force report")
+        self.set_effect = _find(
+            parsed.output_reports, lambda u, a: CONSTANT_FORCE in a and DURATION in u, "a Set Effect report"
+        )
+        self.constant = _find(
+            parsed.output_reports,
+            lambda u, a: MAGNITUDE in u and not (u & OTHER_EFFECT_PARAMETERS),
+            "a Set Constant Force report",
+        )
         self.operation = _find(parsed.output_reports, lambda u, a: OP_START in a, "an Effect Operation report")
         self.control = _find(parsed.output_reports, lambda u, a: ENABLE_ACTUATORS in a, "a Device Control report")
-        self.create = _find(parsed.feature_reports, lambda u, a: CONSTANT_FORCE in a and EFFECT_BLOCK_INDEX not in u,
-                            "a Create New Effect feature report")
+        self.create = _find(
+            parsed.feature_reports,
+            lambda u, a: CONSTANT_FORCE in a and EFFECT_BLOCK_INDEX not in u,
+            "a Create New Effect feature report",
+        )
         self.load = _find(parsed.feature_reports, lambda u, a: LOAD_SUCCESS in a, "a PID Block Load feature report")
         self.gain = _find(parsed.output_reports, lambda u, a: DEVICE_GAIN in u, None)
-        self.free = _find(parsed.output_reports, lambda u, a: BLOCK_FREE_REPORT in a or set(u) == {EFFECT_BLOCK_INDEX}, None)
+        self.free = _find(
+            parsed.output_reports, lambda u, a: BLOCK_FREE_REPORT in a or set(u) == {EFFECT_BLOCK_INDEX}, None
+        )
         for name in ("x", "y"):
             if (X if name == "x" else Y) not in self.joystick.fields:
                 raise PidError(f"the joystick reports no {name} axis")

@@ -52,9 +52,16 @@ def summary_rows(runs, model_name, model, friction_spec):
     for label, result in runs:
         timing, statistics = result.timing(), forces(result)
         prefix = f"{label}." if len(runs) > 1 else ""
-        document = {"device": result.device, "speed": result.speed, "model": model_name,
-                    "friction": friction_spec or "none", "ended_by": result.ended_by, "surface_switches": result.switches,
-                    **timing, **statistics}
+        document = {
+            "device": result.device,
+            "speed": result.speed,
+            "model": model_name,
+            "friction": friction_spec or "none",
+            "ended_by": result.ended_by,
+            "surface_switches": result.switches,
+            **timing,
+            **statistics,
+        }
         documents.append(document)
         rows += _rows(prefix, document, model)
     return rows, {"runs": documents} if len(documents) > 1 else documents[0]
@@ -62,32 +69,68 @@ def summary_rows(runs, model_name, model, friction_spec):
 
 def _rows(prefix, d, model):
     rows = [
-        ("device", d["device"], "", d["device"] + ("" if d["speed"] is None else f", stroking at {format_unit(d['speed'], 'speed')}")),
-        ("model", d["model"], "", _describe(model) + (f"; friction {d['friction']}" if d["friction"] != "none" else "")),
-        ("ticks", d["ticks"], "1", f"{d['ticks']} ticks, {d['simulated_time']:.3f} s of loop time in {d['wall_time']:.3f} s "
-                                   f"({d['realtime_factor']:.0f}× real time)" if "rate" not in d else f"{d['ticks']} ticks in {d['wall_time']:.3f} s"),
+        (
+            "device",
+            d["device"],
+            "",
+            d["device"] + ("" if d["speed"] is None else f", stroking at {format_unit(d['speed'], 'speed')}"),
+        ),
+        (
+            "model",
+            d["model"],
+            "",
+            _describe(model) + (f"; friction {d['friction']}" if d["friction"] != "none" else ""),
+        ),
+        (
+            "ticks",
+            d["ticks"],
+            "1",
+            f"{d['ticks']} ticks, {d['simulated_time']:.3f} s of loop time in {d['wall_time']:.3f} s "
+            f"({d['realtime_factor']:.0f}× real time)"
+            if "rate" not in d
+            else f"{d['ticks']} ticks in {d['wall_time']:.3f} s",
+        ),
     ]
     if "rate" in d:
         rows += [
             ("rate", d["rate"], "Hz", f"{d['rate']:.1f} Hz achieved ({d['scheduling']})"),
-            ("jitter", [d["jitter_p50"], d["jitter_p99"], d["jitter_max"]], "s",
-             f"period jitter p50 {d['jitter_p50'] * 1e6:.1f} µs, p99 {d['jitter_p99'] * 1e6:.1f} µs, max {d['jitter_max'] * 1e6:.1f} µs"),
-            ("missed_deadlines", d["missed_deadlines"], "1",
-             f"{d['missed_deadlines']} missed deadlines (latest tick {d['max_lateness'] * 1e3:.3f} ms late)"),
+            (
+                "jitter",
+                [d["jitter_p50"], d["jitter_p99"], d["jitter_max"]],
+                "s",
+                f"period jitter p50 {d['jitter_p50'] * 1e6:.1f} µs, p99 {d['jitter_p99'] * 1e6:.1f} µs, max {d['jitter_max'] * 1e6:.1f} µs",
+            ),
+            (
+                "missed_deadlines",
+                d["missed_deadlines"],
+                "1",
+                f"{d['missed_deadlines']} missed deadlines (latest tick {d['max_lateness'] * 1e3:.3f} ms late)",
+            ),
         ]
     rows += [
-        ("F_y", [d["F_y_mean"], d["F_y_std"], d["F_y_max"]], "N",
-         f"mean {d['F_y_mean']:.4f} N, std {d['F_y_std']:.4f} N, max {d['F_y_max']:.4f} N"),
+        (
+            "F_y",
+            [d["F_y_mean"], d["F_y_std"], d["F_y_max"]],
+            "N",
+            f"mean {d['F_y_mean']:.4f} N, std {d['F_y_std']:.4f} N, max {d['F_y_max']:.4f} N",
+        ),
         ("F_x_rms", d["F_x_rms"], "N", f"{d['F_x_rms']:.4f} N RMS"),
         ("out_of_contact", d["out_of_contact"], "1", f"{100 * d['out_of_contact']:.2f} % of ticks"),
         ("at_force_limit", d["at_force_limit"], "1", f"{100 * d['at_force_limit']:.2f} % of ticks"),
-        ("ended_by", d["ended_by"], "", d["ended_by"] + (f"; trigger switched surfaces {d['surface_switches']}×" if d["surface_switches"] else "")),
+        (
+            "ended_by",
+            d["ended_by"],
+            "",
+            d["ended_by"] + (f"; trigger switched surfaces {d['surface_switches']}×" if d["surface_switches"] else ""),
+        ),
     ]
     return [(prefix + key, value, unit, text) for key, value, unit, text in rows]
 
 
 def _describe(model):
     if isinstance(model, DynamicStylus):
-        return (f"dynamic stylus: K {format_unit(model.stiffness, 'stiffness')}, M {format_unit(model.mass, 'mass')} "
-                f"({model.mass * 1e-3:.3g} N·s²/mm), C {format_unit(model.damping, 'damping')}")
+        return (
+            f"dynamic stylus: K {format_unit(model.stiffness, 'stiffness')}, M {format_unit(model.mass, 'mass')} "
+            f"({model.mass * 1e-3:.3g} N·s²/mm), C {format_unit(model.damping, 'damping')}"
+        )
     return f"quasi-static: K {format_unit(model.stiffness, 'stiffness')}, M and C negligible"

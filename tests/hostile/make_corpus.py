@@ -53,35 +53,89 @@ def x3p_cases():
         safe = label.replace("/", "-").replace(".", "-")
         case(f"x3p-truncated-at-{safe}.x3p", good[:cut], "", f"a valid X3P cut inside its {label}")
     case("x3p-wrong-magic.x3p", b"PK\x03\x04" + bytes(range(256)) * 4, "", "zip magic followed by noise")
-    case("x3p-no-main-xml.x3p", _zip({"bindata/data.bin": GRID.astype("<f8").tobytes()}), "main.xml", "a zip without main.xml")
+    case(
+        "x3p-no-main-xml.x3p",
+        _zip({"bindata/data.bin": GRID.astype("<f8").tobytes()}),
+        "main.xml",
+        "a zip without main.xml",
+    )
     case("x3p-main-not-xml.x3p", _zip({"main.xml": b"this is not XML <<<"}), "main.xml", "main.xml is not XML")
-    laughs = ('<?xml version="1.0"?><!DOCTYPE lolz [<!ENTITY a "lol">'
-              + "".join(f'<!ENTITY {chr(98 + k)} "{("&" + chr(97 + k) + ";") * 10}">' for k in range(9))
-              + ']><p:ISO5436_2 xmlns:p="http://www.opengps.eu/2008/ISO5436_2">&j;</p:ISO5436_2>').encode()
+    laughs = (
+        '<?xml version="1.0"?><!DOCTYPE lolz [<!ENTITY a "lol">'
+        + "".join(f'<!ENTITY {chr(98 + k)} "{("&" + chr(97 + k) + ";") * 10}">' for k in range(9))
+        + ']><p:ISO5436_2 xmlns:p="http://www.opengps.eu/2008/ISO5436_2">&j;</p:ISO5436_2>'
+    ).encode()
     case("x3p-entity-bomb.x3p", _zip({"main.xml": laughs}), "DOCTYPE", "billion-laughs entity expansion in main.xml")
     utf16 = laughs.replace(b'version="1.0"', b'version="1.0" encoding="UTF-16"').decode().encode("utf-16")
-    case("x3p-entity-bomb-utf16.x3p", _zip({"main.xml": utf16}), "UTF-8", "the entity bomb in UTF-16, past a byte search")
-    case("x3p-external-entity.x3p", x3p_file(GRID, doctype='<!DOCTYPE p [<!ENTITY e SYSTEM "file:///etc/passwd">]>'),
-         "DOCTYPE", "main.xml declares an external entity")
-    case("x3p-main-checksum-wrong.x3p", x3p_file(GRID, main_checksum="bad"), "checksum mismatch", "md5checksum.hex is wrong")
-    case("x3p-main-checksum-missing.x3p", x3p_file(GRID, main_checksum="missing"), "md5checksum.hex", "no md5checksum.hex")
+    case(
+        "x3p-entity-bomb-utf16.x3p", _zip({"main.xml": utf16}), "UTF-8", "the entity bomb in UTF-16, past a byte search"
+    )
+    case(
+        "x3p-external-entity.x3p",
+        x3p_file(GRID, doctype='<!DOCTYPE p [<!ENTITY e SYSTEM "file:///etc/passwd">]>'),
+        "DOCTYPE",
+        "main.xml declares an external entity",
+    )
+    case(
+        "x3p-main-checksum-wrong.x3p",
+        x3p_file(GRID, main_checksum="bad"),
+        "checksum mismatch",
+        "md5checksum.hex is wrong",
+    )
+    case(
+        "x3p-main-checksum-missing.x3p",
+        x3p_file(GRID, main_checksum="missing"),
+        "md5checksum.hex",
+        "no md5checksum.hex",
+    )
     case("x3p-data-checksum-wrong.x3p", x3p_file(GRID, data_checksum="bad"), "checksum mismatch", "data MD5 is wrong")
-    case("x3p-data-checksum-missing.x3p", x3p_file(GRID, data_checksum="missing"), "no MD5 checksum", "data MD5 missing")
-    case("x3p-zip-bomb.x3p", _swap_member(x3p_file(GRID), "bindata/data.bin", bytes(64 << 20)), "header implies",
-         "data.bin inflates to 64 MB for a 4×3 header")
-    case("x3p-member-size-lie.x3p", _lie_about_size(x3p_file(GRID, data_checksum="missing"), "bindata/data.bin", bytes(64 << 20), 96),
-         "", "data.bin's zip entries claim 96 bytes; its deflate stream holds 64 MB")
-    case("x3p-unknown-compression.x3p", _patch_headers(x3p_file(GRID), "main.xml", method=99), "cannot be unpacked",
-         "main.xml compressed with method 99 (found by the fuzzer)")
-    case("x3p-encrypted.x3p", _patch_headers(x3p_file(GRID), "main.xml", flags=0x1), "encrypted", "main.xml marked encrypted")
-    case("x3p-absurd-size.x3p", x3p_file(GRID, size=(1000000, 1000000, 1)), "more than rough handles", "SizeX × SizeY = 10^12")
-    case("x3p-size-mismatch.x3p", x3p_file(GRID, size=(4, 3, 1000000)), "header implies", "SizeZ 10^6 layers in 96 bytes")
+    case(
+        "x3p-data-checksum-missing.x3p", x3p_file(GRID, data_checksum="missing"), "no MD5 checksum", "data MD5 missing"
+    )
+    case(
+        "x3p-zip-bomb.x3p",
+        _swap_member(x3p_file(GRID), "bindata/data.bin", bytes(64 << 20)),
+        "header implies",
+        "data.bin inflates to 64 MB for a 4×3 header",
+    )
+    case(
+        "x3p-member-size-lie.x3p",
+        _lie_about_size(x3p_file(GRID, data_checksum="missing"), "bindata/data.bin", bytes(64 << 20), 96),
+        "",
+        "data.bin's zip entries claim 96 bytes; its deflate stream holds 64 MB",
+    )
+    case(
+        "x3p-unknown-compression.x3p",
+        _patch_headers(x3p_file(GRID), "main.xml", method=99),
+        "cannot be unpacked",
+        "main.xml compressed with method 99 (found by the fuzzer)",
+    )
+    case(
+        "x3p-encrypted.x3p",
+        _patch_headers(x3p_file(GRID), "main.xml", flags=0x1),
+        "encrypted",
+        "main.xml marked encrypted",
+    )
+    case(
+        "x3p-absurd-size.x3p",
+        x3p_file(GRID, size=(1000000, 1000000, 1)),
+        "more than rough handles",
+        "SizeX × SizeY = 10^12",
+    )
+    case(
+        "x3p-size-mismatch.x3p", x3p_file(GRID, size=(4, 3, 1000000)), "header implies", "SizeZ 10^6 layers in 96 bytes"
+    )
     case("x3p-zero-spacing.x3p", x3p_file(GRID, spacing=(0.0, 1e-6)), "spacing", "CX increment 0")
     case("x3p-negative-spacing.x3p", x3p_file(GRID, spacing=(1e-6, -1e-6)), "spacing", "CY increment negative")
     case("x3p-nan-only.x3p", x3p_file(np.full((3, 4), np.nan)), "no valid points", "every height is NaN")
     case("x3p-single-point.x3p", x3p_file(np.ones((1, 1)) * 1e-6), "two points", "a 1 × 1 surface")
     case("x3p-point-cloud.x3p", x3p_file(GRID, feature="PCL"), "point clouds", "a PCL (point list) file")
-    case("x3p-inline-short.x3p", x3p_file(GRID, inline=True, size=(5, 3, 1)), "DataList holds", "DataList shorter than declared")
+    case(
+        "x3p-inline-short.x3p",
+        x3p_file(GRID, inline=True, size=(5, 3, 1)),
+        "DataList holds",
+        "DataList shorter than declared",
+    )
 
 
 def _zip(members):
@@ -106,13 +160,13 @@ def _lie_about_size(blob, name, content, claimed):
     local = patched.find(b"PK\x03\x04" + bytes(0), 0)
     while local >= 0:
         length = struct.unpack_from("<H", patched, local + 26)[0]
-        if bytes(patched[local + 30: local + 30 + length]) == encoded:
+        if bytes(patched[local + 30 : local + 30 + length]) == encoded:
             struct.pack_into("<I", patched, local + 22, claimed)
         local = patched.find(b"PK\x03\x04", local + 4)
     central = patched.find(b"PK\x01\x02")
     while central >= 0:
         length = struct.unpack_from("<H", patched, central + 28)[0]
-        if bytes(patched[central + 46: central + 46 + length]) == encoded:
+        if bytes(patched[central + 46 : central + 46 + length]) == encoded:
             struct.pack_into("<I", patched, central + 24, claimed)
         central = patched.find(b"PK\x01\x02", central + 4)
     return bytes(patched)
@@ -127,7 +181,7 @@ def _patch_headers(blob, name, method=None, flags=None):
         while at >= 0:
             length = struct.unpack_from("<H", patched, at + name_at)[0]
             start = at + name_at + (4 if signature == b"PK\x03\x04" else 18)
-            if bytes(patched[start: start + length]) == encoded:
+            if bytes(patched[start : start + length]) == encoded:
                 if flags is not None:
                     struct.pack_into("<H", patched, at + flags_at, flags)
                 if method is not None:
@@ -158,7 +212,9 @@ def exr_cases():
     chunk = next(x for x in range(8, len(good)) if int.from_bytes(good[x - 8 : x], "little") == x)
     leader = bytearray(good)
     leader[chunk] = 0xFF
-    case("exr-corrupt-chunk-leader.exr", leader, "", "the pixel chunk names scanline 255 (the bindings print to stdout)")
+    case(
+        "exr-corrupt-chunk-leader.exr", leader, "", "the pixel chunk names scanline 255 (the bindings print to stdout)"
+    )
 
 
 # -- GSF ---------------------------------------------------------------------------------------
@@ -166,18 +222,50 @@ def exr_cases():
 
 def gsf_cases():
     case("gsf-no-nul.gsf", b"Gwyddion Simple Field 1.0\nXRes = 2\nYRes = 2\n", "NUL", "header never ends")
-    case("gsf-wrong-version.gsf", gsf(["XRes = 2", "YRes = 2"], np.zeros(4)).replace(b"1.0", b"9.9", 1), "", "version 9.9")
+    case(
+        "gsf-wrong-version.gsf",
+        gsf(["XRes = 2", "YRes = 2"], np.zeros(4)).replace(b"1.0", b"9.9", 1),
+        "",
+        "version 9.9",
+    )
     case("gsf-zero-xres.gsf", gsf(["XRes = 0", "YRes = 2"], []), "XRes", "XRes 0")
-    case("gsf-absurd-size.gsf", gsf(["XRes = 1000000000", "YRes = 1000000000"], np.zeros(4)), "declares", "10^18 points in 16 bytes")
+    case(
+        "gsf-absurd-size.gsf",
+        gsf(["XRes = 1000000000", "YRes = 1000000000"], np.zeros(4)),
+        "declares",
+        "10^18 points in 16 bytes",
+    )
     case("gsf-short-data.gsf", gsf(["XRes = 4", "YRes = 4"], np.zeros(5)), "declares", "16 points declared, 5 present")
-    case("gsf-zero-spacing.gsf", gsf(["XRes = 2", "YRes = 2", "XReal = 0", "YReal = 1e-6"], np.zeros(4)), "XReal", "XReal 0")
-    case("gsf-negative-spacing.gsf", gsf(["XRes = 2", "YRes = 2", "XReal = -1e-6", "YReal = 1e-6"], np.zeros(4)), "XReal",
-         "XReal negative")
-    case("gsf-nan-only.gsf", gsf(["XRes = 2", "YRes = 2", "XReal = 1e-6", "YReal = 1e-6"], np.full(4, np.nan)),
-         "no valid points", "every value NaN")
-    case("gsf-single-point.gsf", gsf(["XRes = 1", "YRes = 1", "XReal = 1e-6", "YReal = 1e-6"], [1.0]), "two points", "one point")
-    case("gsf-infinite-real.gsf", gsf(["XRes = 2", "YRes = 2", "XReal = inf", "YReal = 1e-6"], np.zeros(4)), "XReal",
-         "XReal infinite")
+    case(
+        "gsf-zero-spacing.gsf",
+        gsf(["XRes = 2", "YRes = 2", "XReal = 0", "YReal = 1e-6"], np.zeros(4)),
+        "XReal",
+        "XReal 0",
+    )
+    case(
+        "gsf-negative-spacing.gsf",
+        gsf(["XRes = 2", "YRes = 2", "XReal = -1e-6", "YReal = 1e-6"], np.zeros(4)),
+        "XReal",
+        "XReal negative",
+    )
+    case(
+        "gsf-nan-only.gsf",
+        gsf(["XRes = 2", "YRes = 2", "XReal = 1e-6", "YReal = 1e-6"], np.full(4, np.nan)),
+        "no valid points",
+        "every value NaN",
+    )
+    case(
+        "gsf-single-point.gsf",
+        gsf(["XRes = 1", "YRes = 1", "XReal = 1e-6", "YReal = 1e-6"], [1.0]),
+        "two points",
+        "one point",
+    )
+    case(
+        "gsf-infinite-real.gsf",
+        gsf(["XRes = 2", "YRes = 2", "XReal = inf", "YReal = 1e-6"], np.zeros(4)),
+        "XReal",
+        "XReal infinite",
+    )
 
 
 # -- text ----------------------------------------------------------------------------------------
@@ -190,18 +278,46 @@ def text_cases():
     case("text-nan-only.txt", b"x z\n0 nan\n1 nan\n2 nan\n", "no valid points", "every height NaN")
     case("text-overflow.txt", b"x z\n0 1e400\n1 1e400\n2 -1e400\n", "no valid points", "heights overflow to infinity")
     case("text-bom-only.txt", b"\xef\xbb\xbf", "empty", "a UTF-8 byte-order mark and nothing else")
-    case("text-utf16-odd-length.txt", b"\xff\xfe" + "x z\n0 1\n".encode("utf-16-le") + b"\x00", "", "UTF-16 with a dangling byte")
+    case(
+        "text-utf16-odd-length.txt",
+        b"\xff\xfe" + "x z\n0 1\n".encode("utf-16-le") + b"\x00",
+        "",
+        "UTF-16 with a dangling byte",
+    )
     case("text-bom-then-binary.txt", b"\xef\xbb\xbf" + bytes(range(256)), "", "a BOM then binary junk")
-    case("text-mixed-encodings.txt", "x z\n0 1\n1 2µ\n".encode() + b"2 3\xb5\n", "", "UTF-8 and Latin-1 mixed inside numbers")
+    case(
+        "text-mixed-encodings.txt",
+        "x z\n0 1\n1 2µ\n".encode() + b"2 3\xb5\n",
+        "",
+        "UTF-8 and Latin-1 mixed inside numbers",
+    )
     case("text-unknown-unit.txt", b"# unit: furlong\nx z\n0 1\n1 2\n2 3\n", "furlong", "a unit that does not exist")
     case("text-words.txt", b"roughness measurements\nsample A was rough\nthe end\n", "", "prose, no numbers")
     case("text-ragged.txt", b"x z\n0 1\n1 2 3 4\n2\n", "", "rows of different lengths")
-    case("text-xyz-irregular.txt", b"x y z\n0 0 1\n0.3 0 1\n1.7 0 1\n0 1 1\n0.3 1 1\n1.7 1 1\n", "", "x y z on an uneven grid")
-    case("text-dektak-truncated.csv", b"Meta Data\nVersion,1.0\nScan Rate,1\nResolution,0.156 um/sample\n", "", "Dektak header with no data")
-    case("text-dektak-no-rows.csv", b"Scan Parameters\r\r\nLength,0.8 um\r\n\r\r\nScan Data\r\r\nLateral um,Raw Micrometer,\r\n",
-         "no numeric data", "Dektak scan: header and column names, no data rows")
-    case("text-gwyddion-zero-width.txt", b"Channel: Height\nWidth: 0 um\nHeight: 1 um\nValue units: m\n"
-         b"Data values:\n1 2\n3 4\n", "", "Gwyddion text export with zero width")
+    case(
+        "text-xyz-irregular.txt",
+        b"x y z\n0 0 1\n0.3 0 1\n1.7 0 1\n0 1 1\n0.3 1 1\n1.7 1 1\n",
+        "",
+        "x y z on an uneven grid",
+    )
+    case(
+        "text-dektak-truncated.csv",
+        b"Meta Data\nVersion,1.0\nScan Rate,1\nResolution,0.156 um/sample\n",
+        "",
+        "Dektak header with no data",
+    )
+    case(
+        "text-dektak-no-rows.csv",
+        b"Scan Parameters\r\r\nLength,0.8 um\r\n\r\r\nScan Data\r\r\nLateral um,Raw Micrometer,\r\n",
+        "no numeric data",
+        "Dektak scan: header and column names, no data rows",
+    )
+    case(
+        "text-gwyddion-zero-width.txt",
+        b"Channel: Height\nWidth: 0 um\nHeight: 1 um\nValue units: m\nData values:\n1 2\n3 4\n",
+        "",
+        "Gwyddion text export with zero width",
+    )
     case("text-long-line.txt", b"x z\n" + b"1" * (1 << 20) + b" 2\n0 1\n", "", "a 4 MB number")
 
 
@@ -215,27 +331,64 @@ def npy(header, body=b"", version=(1, 0)):
 
 
 def npy_cases():
-    case("npy-absurd-shape.npy", npy({"descr": "<f8", "fortran_order": False, "shape": (10**6, 10**6)}, bytes(64)), "declares",
-         "10^12 points declared, 8 present")
-    case("npy-object-pickle.npy", npy({"descr": "|O", "fortran_order": False, "shape": (2,)}, b"\x80\x04N."), "",
-         "an object array: reading it would unpickle")
-    case("npy-three-d.npy", npy({"descr": "<f8", "fortran_order": False, "shape": (2, 2, 2)}, bytes(64)), "", "a 3-D array")
-    case("npy-complex.npy", npy({"descr": "<c16", "fortran_order": False, "shape": (4,)}, bytes(64)), "", "complex values")
-    case("npy-strings.npy", npy({"descr": "<U3", "fortran_order": False, "shape": (3,)}, "abcdefghi".encode("utf-32-le")),
-         "", "strings")
+    case(
+        "npy-absurd-shape.npy",
+        npy({"descr": "<f8", "fortran_order": False, "shape": (10**6, 10**6)}, bytes(64)),
+        "declares",
+        "10^12 points declared, 8 present",
+    )
+    case(
+        "npy-object-pickle.npy",
+        npy({"descr": "|O", "fortran_order": False, "shape": (2,)}, b"\x80\x04N."),
+        "",
+        "an object array: reading it would unpickle",
+    )
+    case(
+        "npy-three-d.npy",
+        npy({"descr": "<f8", "fortran_order": False, "shape": (2, 2, 2)}, bytes(64)),
+        "",
+        "a 3-D array",
+    )
+    case(
+        "npy-complex.npy",
+        npy({"descr": "<c16", "fortran_order": False, "shape": (4,)}, bytes(64)),
+        "",
+        "complex values",
+    )
+    case(
+        "npy-strings.npy",
+        npy({"descr": "<U3", "fortran_order": False, "shape": (3,)}, "abcdefghi".encode("utf-32-le")),
+        "",
+        "strings",
+    )
     case("npy-bad-header.npy", npy(b"{'descr': '<f8', 'shape': (3,"), "", "a header that is not a dict")
-    case("npy-bad-version.npy", npy({"descr": "<f8", "fortran_order": False, "shape": (2,)}, bytes(16), version=(9, 9)), "",
-         "NPY version 9.9")
+    case(
+        "npy-bad-version.npy",
+        npy({"descr": "<f8", "fortran_order": False, "shape": (2,)}, bytes(16), version=(9, 9)),
+        "",
+        "NPY version 9.9",
+    )
 
 
 # -- SDF and AL3D -----------------------------------------------------------------------------------
 
 
 def sdf_cases():
-    ascii_header = "aISO-1.0\nNumPoints = {n}\nNumProfiles = {m}\nXscale = {x}\nYscale = 1e-6\nZscale = 1e-6\nDataType = 7\n*\n"
-    case("sdf-ascii-count.sdf", (ascii_header.format(n=3, m=2, x=1e-6) + "1 2 3\n*\n").encode(), "holds 3 values",
-         "6 values declared, 3 present")
-    case("sdf-ascii-huge.sdf", (ascii_header.format(n=10**9, m=10**9, x=1e-6) + "1 2\n*\n").encode(), "", "10^18 points declared")
+    ascii_header = (
+        "aISO-1.0\nNumPoints = {n}\nNumProfiles = {m}\nXscale = {x}\nYscale = 1e-6\nZscale = 1e-6\nDataType = 7\n*\n"
+    )
+    case(
+        "sdf-ascii-count.sdf",
+        (ascii_header.format(n=3, m=2, x=1e-6) + "1 2 3\n*\n").encode(),
+        "holds 3 values",
+        "6 values declared, 3 present",
+    )
+    case(
+        "sdf-ascii-huge.sdf",
+        (ascii_header.format(n=10**9, m=10**9, x=1e-6) + "1 2\n*\n").encode(),
+        "",
+        "10^18 points declared",
+    )
     case("sdf-ascii-zero-xscale.sdf", (ascii_header.format(n=2, m=2, x=0) + "1 2 3 4\n*\n").encode(), "", "Xscale 0")
     case("sdf-binary-truncated.sdf", sdf_binary(4, 4, body=bytes(40)), "too short", "16 doubles declared, 5 present")
     case("sdf-binary-bad-type.sdf", sdf_binary(2, 2, datatype=9, body=bytes(32)), "", "DataType 9 does not exist")
@@ -246,11 +399,25 @@ def sdf_cases():
 def al3d_cases():
     zeros = np.zeros((2, 2))
     case("al3d-truncated-header.al3d", al3d_file(zeros)[:120], "truncated", "cut inside the tags")
-    case("al3d-absurd-size.al3d", al3d_file(zeros, tags={"Cols": 10**9, "Rows": 10**9}), "runs past the end", "10^18 pixels")
+    case(
+        "al3d-absurd-size.al3d",
+        al3d_file(zeros, tags={"Cols": 10**9, "Rows": 10**9}),
+        "runs past the end",
+        "10^18 pixels",
+    )
     case("al3d-zero-pixel.al3d", al3d_file(zeros, pixel=(0, 1e-6)), "pixel size", "pixel size 0")
-    case("al3d-tag-count.al3d", al3d_file(zeros)[:17 + 52] + b"TagCount".ljust(20, b"\0") + b"99999999".ljust(30, b"\0") + b"\r\n",
-         "tag count", "TagCount 99999999")
-    case("al3d-all-invalid.al3d", al3d_file(np.full((2, 2), 1e30), invalid=1e30), "no valid points", "every pixel invalid")
+    case(
+        "al3d-tag-count.al3d",
+        al3d_file(zeros)[: 17 + 52] + b"TagCount".ljust(20, b"\0") + b"99999999".ljust(30, b"\0") + b"\r\n",
+        "tag count",
+        "TagCount 99999999",
+    )
+    case(
+        "al3d-all-invalid.al3d",
+        al3d_file(np.full((2, 2), 1e30), invalid=1e30),
+        "no valid points",
+        "every pixel invalid",
+    )
 
 
 # -- compressed and anything else ---------------------------------------------------------------------
