@@ -58,11 +58,13 @@ def main():
     fit_memory = peak_memory(lambda: fit_fractal(surface)) / size
     print(f"rough {rough.__version__}, {n}×{n} map ({size / 1e6:.0f} MB float64), median of {repeat}")
     print(
-        f"synth        {synth_time:6.3f} s = {synth_time / irfft_single:4.2f}× irfft2 single-threaded ({irfft_single:.3f} s), "
+        f"synth        {synth_time:6.3f} s = {synth_time / irfft_single:4.2f}× irfft2 single-threaded "
+        f"({irfft_single:.3f} s), "
         f"{synth_time / irfft_all:4.2f}× irfft2 on all cores ({irfft_all:.3f} s)   goal ≤ 1.5×"
     )
     print(
-        f"fit-fractal  {fit_time:6.3f} s = {fit_time / rfft_single:4.2f}× rfft2 single-threaded ({rfft_single:.3f} s)   goal ≤ 3×"
+        f"fit-fractal  {fit_time:6.3f} s = {fit_time / rfft_single:4.2f}× rfft2 single-threaded "
+        f"({rfft_single:.3f} s)   goal ≤ 3×"
     )
     print(f"peak memory  synth {synth_memory:.2f}×, fit-fractal {fit_memory:.2f}× the map's float64 size   goal ≤ 4×")
     half = n // 2
@@ -71,7 +73,8 @@ def main():
     rfft_small = median_time(lambda: fft.rfft2(small_field), repeat)
     rose_time = median_time(lambda: rose(small), repeat)
     print(
-        f"rose {half}×{half} {rose_time:6.3f} s = {rose_time / rfft_small:4.1f}× rfft2 single-threaded ({rfft_small:.3f} s)"
+        f"rose {half}×{half} {rose_time:6.3f} s = {rose_time / rfft_small:4.1f}× rfft2 single-threaded "
+        f"({rfft_small:.3f} s)"
     )
     try:
         from SurfaceTopography.Generation import fourier_synthesis
@@ -83,10 +86,12 @@ def main():
     their_synth = median_time(lambda: fourier_synthesis((n, n), physical, 0.7, rms_height=1e-6), repeat)
     their_psd = median_time(lambda: theirs.power_spectrum_from_area(), repeat)
     print(
-        f"SurfaceTopography fourier_synthesis {their_synth:.3f} s: rough synth is {their_synth / synth_time:.1f}× faster (goal ≥ 3×)"
+        f"SurfaceTopography fourier_synthesis {their_synth:.3f} s: rough synth is "
+        f"{their_synth / synth_time:.1f}× faster (goal ≥ 3×)"
     )
     print(
-        f"SurfaceTopography power_spectrum_from_area {their_psd:.3f} s: rough fit-fractal is {their_psd / fit_time:.1f}× faster (goal ≥ 2×)"
+        f"SurfaceTopography power_spectrum_from_area {their_psd:.3f} s: rough fit-fractal is "
+        f"{their_psd / fit_time:.1f}× faster (goal ≥ 2×)"
     )
 
 

@@ -36,7 +36,8 @@ def startup(repeat):
     help_time = median_time(lambda: subprocess.run([rough_cli, "--help"], check=True, capture_output=True), repeat * 5)
     bare = median_time(lambda: subprocess.run([sys.executable, "-c", "pass"], check=True), repeat * 5)
     print(
-        f"start-up   rough --help {help_time * 1e3:7.1f} ms   python -c pass {bare * 1e3:6.1f} ms   ratio {help_time / bare:5.2f}×   (goal ≤ 150 ms)"
+        f"start-up   rough --help {help_time * 1e3:7.1f} ms   python -c pass {bare * 1e3:6.1f} ms   "
+        f"ratio {help_time / bare:5.2f}×   (goal ≤ 150 ms)"
     )
 
 
@@ -55,7 +56,8 @@ def formats(surface, folder, repeat):
     write_raw = median_time(lambda: surface.heights.tofile(raw_path), repeat)
     read_raw = median_time(lambda: np.fromfile(raw_path), repeat)
     print(
-        f"raw dump   write {write_raw:7.3f} s   read {read_raw:7.3f} s   ({surface.heights.nbytes / 1e6:.0f} MB float64)"
+        f"raw dump   write {write_raw:7.3f} s   read {read_raw:7.3f} s   "
+        f"({surface.heights.nbytes / 1e6:.0f} MB float64)"
     )
     for fmt in ("x3p", "exr", "gsf", "npy", "tsv"):
         path = os.path.join(folder, f"map.{fmt}")
@@ -77,7 +79,8 @@ def main():
     heights = np.random.default_rng(0).standard_normal((options.size, options.size)) * 1e-6
     surface = rough.Surface(heights, (1e-6, 1e-6))
     print(
-        f"rough {rough.__version__}, {options.size}×{options.size} map, median of {options.repeat} runs, {os.cpu_count()} CPUs"
+        f"rough {rough.__version__}, {options.size}×{options.size} map, median of {options.repeat} runs, "
+        f"{os.cpu_count()} CPUs"
     )
     with tempfile.TemporaryDirectory(dir=os.environ.get("TMPDIR")) as folder:
         startup(options.repeat)

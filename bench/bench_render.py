@@ -36,7 +36,8 @@ def simulated(track):
         best = sorted(factors)[1]
         per_tick = 1e6 / (best * 1000)
         print(
-            f"sim {name:<24} {result.ticks} ticks: {best:6.0f}× real time ({per_tick:.2f} µs per 1 ms tick)   goal ≥ 500×"
+            f"sim {name:<24} {result.ticks} ticks: {best:6.0f}× real time ({per_tick:.2f} µs per 1 ms "
+            f"tick)   goal ≥ 500×"
         )
 
 
@@ -45,9 +46,11 @@ def realtime(track, seconds):
     timing = result.timing()
     late = timing["max_lateness"] * 1e3
     print(
-        f"real time {seconds:g} s at 1 kHz ({timing['scheduling']}): rate {timing['rate']:.2f} Hz, period jitter p50 {timing['jitter_p50'] * 1e6:.1f} µs, "
+        f"real time {seconds:g} s at 1 kHz ({timing['scheduling']}): rate {timing['rate']:.2f} Hz, "
+        f"period jitter p50 {timing['jitter_p50'] * 1e6:.1f} µs, "
         f"p99 {timing['jitter_p99'] * 1e6:.1f} µs, max {timing['jitter_max'] * 1e6:.1f} µs; "
-        f"missed deadlines {timing['missed_deadlines']}, latest tick {late:.3f} ms late   goal p99 ≤ 50 µs, lateness ≤ 1 ms"
+        f"missed deadlines {timing['missed_deadlines']}, latest tick {late:.3f} ms late   goal p99 ≤ 50 "
+        f"µs, lateness ≤ 1 ms"
     )
 
 

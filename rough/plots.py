@@ -85,7 +85,8 @@ def spectrum_figure(frequencies, density, fit, title="power spectrum"):
         fit.psd_prefactor * grid**-exponent,
         color="tab:red",
         lw=2,
-        label=f"fit: {'D' if fit.profile_dimension is None else 'Ds'} = {fit.fractal_dimension:.4f} ± {fit.fractal_dimension_stderr:.4f}",
+        label=f"fit: {'D' if fit.profile_dimension is None else 'Ds'} = "
+        f"{fit.fractal_dimension:.4f} ± {fit.fractal_dimension_stderr:.4f}",
     )
     axes.axvspan(low * 1e-3, high * 1e-3, color="tab:red", alpha=0.06, label="fit band")
     axes.set_xlabel("spatial frequency (1/mm)")
@@ -126,7 +127,8 @@ def rose_figure(rose, title="direction dependence"):
                 axis.plot(np.radians([direction, direction]), [inner, outer], style, color="0.3", lw=1)
         axis.set_title(label, pad=14)
     figure.suptitle(
-        f"{title}\nprincipal wavevector {rose.principal_direction:.1f}° (solid), lay {rose.lay_direction:.1f}° (dashed); "
+        f"{title}\nprincipal wavevector {rose.principal_direction:.1f}° (solid), lay "
+        f"{rose.lay_direction:.1f}° (dashed); "
         f"Str {'undefined' if np.isnan(rose.Str) else format(rose.Str, '.3g')}, Std {rose.Std:.1f}°",
         fontsize=10,
     )

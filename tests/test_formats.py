@@ -188,7 +188,10 @@ def test_binary_sdf():
 
 
 def test_ascii_sdf_with_bad_points():
-    body = "aISO-1.0\nNumPoints = 2\nNumProfiles = 2\nXscale = 1e-6\nYscale = 1e-6\nZscale = 1e-6\nDataType = 7\n*\n1 BAD\n3 4\n*\n"
+    body = (
+        "aISO-1.0\nNumPoints = 2\nNumProfiles = 2\nXscale = 1e-6\nYscale = 1e-6\nZscale = 1e-6\nDataType = 7\n"
+        "*\n1 BAD\n3 4\n*\n"
+    )
     surface = text(body)
     assert np.isnan(surface.heights[0, 1]) and surface.heights[1, 1] == pytest.approx(4e-6)
 

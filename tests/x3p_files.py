@@ -80,7 +80,8 @@ def x3p_file(
         data_xml = f"<DataLink><PointDataLink>bindata/data.bin</PointDataLink>{checksum}{mask_xml}</DataLink>"
     record2_xml = (
         "<Record2><Date>2020-01-02T03:04:05</Date><Creator>A. Tester</Creator>"
-        "<Instrument><Manufacturer>Acme</Manufacturer><Model>Profilo 9</Model><Serial>42</Serial><Version>1.0</Version></Instrument>"
+        "<Instrument><Manufacturer>Acme</Manufacturer><Model>Profilo "
+        "9</Model><Serial>42</Serial><Version>1.0</Version></Instrument>"
         "<CalibrationDate>2019-12-31T00:00:00</CalibrationDate>"
         "<ProbingSystem><Type>Contacting</Type><Identification>2um tip</Identification></ProbingSystem>"
         "<Comment>hand-made test file</Comment></Record2>"

@@ -21,14 +21,16 @@ from .options import LENGTH, TIP, crop_option, surface_input, surface_output
     type=click.Choice(["roughness", "waviness", "form"]),
     default="roughness",
     show_default=True,
-    help="What to output: the roughness (form removed, filtered with --cutoff), the waviness (the Gaussian mean line) or the fitted form.",
+    help="What to output: the roughness (form removed, filtered with --cutoff), the waviness (the "
+    "Gaussian mean line) or the fitted form.",
 )
 @click.option(
     "--ends",
     type=click.Choice(["trim", "correct"]),
     default="trim",
     show_default=True,
-    help="Filter end effects: trim λc/2 at each end, or keep the full length with the renormalised kernel (ISO 16610-28).",
+    help="Filter end effects: trim λc/2 at each end, or keep the full length with the renormalised "
+    "kernel (ISO 16610-28).",
 )
 @click.option(
     "--tip",

@@ -286,7 +286,8 @@ def _table(study, result, set_id):
             ratio,
             "",
             (
-                f"D: χ²(1) = {ratio['fractal_dimension']['statistic']:.4g}, p = {_p(ratio['fractal_dimension']['p'])};  "
+                f"D: χ²(1) = {ratio['fractal_dimension']['statistic']:.4g}, p = "
+                f"{_p(ratio['fractal_dimension']['p'])};  "
                 f"Rq: χ²(1) = {ratio['rq']['statistic']:.4g}, p = {_p(ratio['rq']['p'])}"
             ),
         ),

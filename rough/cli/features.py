@@ -212,7 +212,8 @@ def _scaling_rows(scaling):
             "scaling",
             scaling["hurst"],
             "1",
-            f"{key} ∝ L^{scaling['hurst']:.3f}: H = {scaling['hurst']:.3f}, D = {scaling['fractal_dimension']:.3f} (window means removed)",
+            f"{key} ∝ L^{scaling['hurst']:.3f}: H = {scaling['hurst']:.3f}, D = "
+            f"{scaling['fractal_dimension']:.3f} (window means removed)",
         )
     )
     return rows

@@ -70,7 +70,8 @@ def fit_fractal(surface, input, band, resolution, method, order, sampling, fill,
     if psd_file:
         unit = "m3" if surface.is_profile else "m4"
         lines = [
-            f"# rough fit-fractal: log-binned spectrum ({'Hann periodogram G' if surface.is_profile else 'ring-averaged P2'})",
+            f"# rough fit-fractal: log-binned spectrum "
+            f"({'Hann periodogram G' if surface.is_profile else 'ring-averaged P2'})",
             f"frequency_per_m\tdensity_{unit}\tcount",
         ]
         lines += [
@@ -122,7 +123,8 @@ def _rows(result, surface, document):
             "amplitude_coefficient",
             result.amplitude_coefficient,
             "m",
-            f"C = {format_length(result.amplitude_coefficient)} ± {format_length(result.amplitude_coefficient_stderr)} at η = {format_length(result.resolution)}",
+            f"C = {format_length(result.amplitude_coefficient)} ± "
+            f"{format_length(result.amplitude_coefficient_stderr)} at η = {format_length(result.resolution)}",
         ),
         (
             "psd_prefactor",
@@ -142,7 +144,8 @@ def _rows(result, surface, document):
             list(result.band),
             "1/m",
             (
-                f"{low * 1e-3:.4g} to {high * 1e-3:.4g} /mm (wavelengths {format_length(1 / high)} to {format_length(1 / low)}), "
+                f"{low * 1e-3:.4g} to {high * 1e-3:.4g} /mm (wavelengths {format_length(1 / high)} to "
+                f"{format_length(1 / low)}), "
                 f"{result.frequencies_used} frequencies"
             ),
         ),

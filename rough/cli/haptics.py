@@ -87,7 +87,8 @@ def haptic_options(command):
             default="sim",
             show_default=True,
             metavar="sim|hid[:VID:PID]",
-            help="sim: a simulated hand; hid: the first HID PID force-feedback joystick (or the one with these hex IDs).",
+            help="sim: a simulated hand; hid: the first HID PID force-feedback joystick (or the one with "
+            "these hex IDs).",
         ),
         click.option("--rate", type=RATE, default="1kHz", show_default=True, help="Servo rate."),
         click.option(
@@ -125,7 +126,8 @@ def haptic_options(command):
             "--stick-span",
             type=SPACING,
             metavar="X,Y",
-            help="hid: lengths the stick's full x and y travel cover (default: the window, and 4× the profile's height range).",
+            help="hid: lengths the stick's full x and y travel cover (default: the window, and 4× the "
+            "profile's height range).",
         ),
         click.option(
             "--invert", type=click.Choice(["x", "y"]), multiple=True, help="hid: reverse an axis (position and force)."

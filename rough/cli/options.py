@@ -183,7 +183,8 @@ def input_options(spacing_flag="--spacing", most=1):
                 spacing_flag,
                 "spacing",
                 type=SPACING,
-                help="Spacing of input data that carry none (NPY, a column of heights), e.g. 1um or 1um,2um; overrides a file's own.",
+                help="Spacing of input data that carry none (NPY, a column of heights), e.g. 1um or "
+                "1um,2um; overrides a file's own.",
             ),
             click.option("--unit", metavar="UNIT", help="Length unit of text values that name none (default m)."),
             click.option(

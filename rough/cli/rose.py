@@ -132,7 +132,8 @@ def _rows(result):
             "",
             "not tested (overlapping sectors)"
             if isotropy["fractal_dimension"] is None
-            else f"χ² p-values: Ds flat {isotropy['fractal_dimension']:.3g}, C flat {isotropy['amplitude_coefficient']:.3g}",
+            else f"χ² p-values: Ds flat {isotropy['fractal_dimension']:.3g}, "
+            f"C flat {isotropy['amplitude_coefficient']:.3g}",
         ),
         ("Str", result.Str, "1", f"{format_quantity(result.Str, '1')} (texture aspect ratio, ISO 25178-2)"),
         ("Std", result.Std, "deg", f"{format_quantity(result.Std, 'deg')} (lay direction from the angular spectrum)"),

@@ -74,7 +74,8 @@ class AnisotropyType(click.ParamType):
 @click.option(
     "--anisotropy",
     type=AnisotropyType(),
-    help="Map: Ds and C along the wavevector direction ANGLE (degrees from +x) and at right angles, e.g. 2.2,1um,2.4,3um,30.",
+    help="Map: Ds and C along the wavevector direction ANGLE (degrees from +x) and at right angles, e.g. "
+    "2.2,1um,2.4,3um,30.",
 )
 @click.option(
     "--rolloff",
@@ -86,7 +87,8 @@ class AnisotropyType(click.ParamType):
     type=click.IntRange(4, None),
     is_flag=False,
     flag_value=128,
-    help="The paper's method, for comparison: fragments of this many points (default 128), each started where the last ended.",
+    help="The paper's method, for comparison: fragments of this many points (default 128), each started "
+    "where the last ended.",
 )
 @click.option("--as-printed", is_flag=True, help="With --fragments: also apply the paper's printed (k+1) index shift.")
 @surface_output

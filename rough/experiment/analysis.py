@@ -60,7 +60,8 @@ def answers_table(study, set_id=None):
         rows = [row for row in rows if int(row["set"]) == set_id]
     if not rows:
         raise InputError(
-            f"{study.folder}: no answers yet{'' if set_id is None else f' for set {set_id}'} (run sessions with rough experiment run)"
+            f"{study.folder}: no answers yet{'' if set_id is None else f' for set {set_id}'} (run "
+            f"sessions with rough experiment run)"
         )
     return {
         "rougher": np.array([int(r["test_rougher"]) for r in rows], dtype=float),

@@ -45,7 +45,8 @@ def parse_observer(spec):
         key = key.strip()
         if not equals or key not in KEYS:
             raise InputError(
-                f"--observer takes {', '.join(f'{k}=' for k in KEYS)} ({', '.join(f'{k}: {v}' for k, v in KEYS.items())}); not {item!r}"
+                f"--observer takes {', '.join(f'{k}=' for k in KEYS)} "
+                f"({', '.join(f'{k}: {v}' for k, v in KEYS.items())}); not {item!r}"
             )
         try:
             values[key] = int(value) if key == "seed" else float(value)

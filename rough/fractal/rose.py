@@ -15,8 +15,9 @@ C(θ) is the profile-equivalent amplitude coefficient (as ``synth --anisotropy``
 takes it). The principal direction is the θ of the largest C in a weighted fit of
 the rose's elliptical part, log C(θ) = a + b cos 2(θ - θp); D and C along θp and
 θp + 90° come from sectors centred there. A rose that is not elliptical (a narrow
-streak, say) can have its largest sector elsewhere; that sector is reported too. With non-overlapping sectors, χ² tests of flatness of D(θ) and C(θ)
-say whether the anisotropy is significant. Str and Std (ISO 25178-2) come along.
+streak, say) can have its largest sector elsewhere; that sector is reported too.
+With non-overlapping sectors, χ² tests of flatness of D(θ) and C(θ) say whether
+the anisotropy is significant. Str and Std (ISO 25178-2) come along.
 """
 
 import dataclasses
@@ -138,7 +139,8 @@ def rose(surface, step=10.0, width=None, band=None, resolution=None, order=1, sa
 def _sector_fit(rings, resolution):
     if rings["count"].size < 4:
         raise InputError(
-            f"a sector holds only {rings['count'].size} frequency rings in the band; use wider sectors (--width) or a wider band"
+            f"a sector holds only {rings['count'].size} frequency rings in the band; use wider sectors "
+            f"(--width) or a wider band"
         )
     return ring_fit(rings, resolution)
 

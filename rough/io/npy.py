@@ -32,7 +32,8 @@ def read(data, options):
     available = len(data) - stream.tell()
     if count * dtype.itemsize > available:
         raise FormatError(
-            f"NPY header declares {'×'.join(map(str, shape))} values of {dtype.itemsize} bytes; the file holds {available} bytes"
+            f"NPY header declares {'×'.join(map(str, shape))} values of {dtype.itemsize} bytes; the file "
+            f"holds {available} bytes"
         )
     if options.spacing is None:
         raise FormatError("NPY files carry no spacing; give it with --spacing (e.g. --spacing 1um)")

@@ -452,7 +452,8 @@ def _main_xml(surface, data_md5, mask_md5):
     return (
         '<?xml version="1.0" encoding="UTF-8"?>\n'
         f'<p:ISO5436_2 xmlns:p="{NAMESPACE}">\n'
-        f"<Record1><Revision>ISO5436 - 2000</Revision><FeatureType>{'PRF' if surface.is_profile else 'SUR'}</FeatureType>"
+        f"<Record1><Revision>ISO5436 - "
+        f"2000</Revision><FeatureType>{'PRF' if surface.is_profile else 'SUR'}</FeatureType>"
         f"<Axes>{axes}<CZ><AxisType>A</AxisType><DataType>D</DataType><Increment>1.0</Increment><Offset>0.0</Offset></CZ></Axes></Record1>\n"
         f"<Record2><Date>{escape(m.get('date') or now)}</Date>{creator}"
         f"<Instrument><Manufacturer>{fields['manufacturer']}</Manufacturer><Model>{fields['model']}</Model>"

@@ -51,8 +51,8 @@ def form_factors(surface, order=2):
     right = np.empty(len(terms))
     for a, (i, j) in enumerate(terms):
         right[a] = along_y[:, j] @ projected[:, i]
-        for b, (k, l) in enumerate(terms):
-            gram[a, b] = (along_y[:, j] * along_y[:, l]) @ weighted_x[min(i, k), max(i, k)]
+        for b, (k, m) in enumerate(terms):
+            gram[a, b] = (along_y[:, j] * along_y[:, m]) @ weighted_x[min(i, k), max(i, k)]
     _check_determined(gram, valid, order, surface.heights.ndim)
     coefficients = np.zeros((along_y.shape[1], order + 1))
     for (i, j), value in zip(terms, np.linalg.solve(gram, right)):

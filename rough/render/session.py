@@ -98,7 +98,8 @@ def _rows(prefix, d, model):
                 "jitter",
                 [d["jitter_p50"], d["jitter_p99"], d["jitter_max"]],
                 "s",
-                f"period jitter p50 {d['jitter_p50'] * 1e6:.1f} µs, p99 {d['jitter_p99'] * 1e6:.1f} µs, max {d['jitter_max'] * 1e6:.1f} µs",
+                f"period jitter p50 {d['jitter_p50'] * 1e6:.1f} µs, p99 {d['jitter_p99'] * 1e6:.1f} µs, "
+                f"max {d['jitter_max'] * 1e6:.1f} µs",
             ),
             (
                 "missed_deadlines",
