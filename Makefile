@@ -1,20 +1,33 @@
 # Two set-up commands for a fresh machine (each installs what it needs):
 #   make demo   a demo pipeline on the embedded sample files
 #   make test   the test suite
+# Both build the wheel and install it (not editable, with every extra) into .venv, so they
+# run what a user installs; the wheel is rebuilt whenever a source file changes.
 PYTHON ?= python3
 VENV ?= .venv
 BIN = $(VENV)/bin
 DEMO = build/demo
+SOURCES = setup.cfg pyproject.toml LICENSE README.md $(shell find rough sample_profiles -name '*.py' -o -name '*.tsv' -o -name '*.x3p')
 
-.PHONY: demo test bench fuzz clean
+.PHONY: demo demo-pipeline test lint format docs wheel bench fuzz clean
 
-$(BIN)/.installed: setup.cfg pyproject.toml
-	$(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e '.[test]'
+$(BIN)/.installed: $(SOURCES)
+	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip setuptools wheel
+	$(BIN)/python -m pip uninstall --quiet --yes rough 2>/dev/null || true  # the distribution's name up to 0.1.0
+	rm -rf dist build/lib build/bdist.*
+	$(BIN)/python -m pip wheel --quiet --no-deps --no-build-isolation --wheel-dir dist .
+	$(BIN)/python -m pip install --quiet "$$(ls dist/rough_metrology-*.whl)[all,test,lint,docs]"
+	$(BIN)/python -m pip install --quiet --no-deps --force-reinstall dist/rough_metrology-*.whl
 	touch $@
 
+wheel: $(BIN)/.installed
+
 demo: $(BIN)/.installed
+	$(MAKE) --no-print-directory demo-pipeline BIN=$(BIN)
+
+# the pipeline alone, with the rough installed in $(BIN) (.ci/run points it at a fresh install)
+demo-pipeline:
 	@mkdir -p $(DEMO)
 	@echo '$$ rough info sample_profiles/rock-profile.tsv'
 	@$(BIN)/rough info sample_profiles/rock-profile.tsv
@@ -53,8 +66,23 @@ demo: $(BIN)/.installed
 	@echo '$$ rough experiment analyze $(DEMO)/study --set 1 --plot $(DEMO)/figure4.png'
 	@$(BIN)/rough experiment analyze $(DEMO)/study --set 1 --plot $(DEMO)/figure4.png
 
+# PYTHONSAFEPATH keeps the source tree off sys.path: the tests import the installed wheel
 test: $(BIN)/.installed
-	$(BIN)/python -m pytest -q
+	PYTHONSAFEPATH=1 $(BIN)/python -m pytest -q
+
+lint: $(BIN)/.installed
+	$(BIN)/ruff check .
+	$(BIN)/ruff format --check .
+	$(BIN)/python .ci/check_version.py
+
+format: $(BIN)/.installed
+	$(BIN)/ruff check --fix .
+	$(BIN)/ruff format .
+
+docs: $(BIN)/.installed
+	rm -rf build/docs docs/auto_examples
+	PATH="$(abspath $(BIN)):$$PATH" PYTHONSAFEPATH=1 $(BIN)/python -m sphinx -W --keep-going -q -b html docs build/docs
+	@echo "documentation: build/docs/index.html"
 
 bench: $(BIN)/.installed
 	$(BIN)/python bench/bench_io.py
@@ -64,8 +92,8 @@ bench: $(BIN)/.installed
 	$(BIN)/python bench/bench_tip.py
 
 fuzz: $(BIN)/.installed
-	$(BIN)/python -m pip install --quiet -e '.[fuzz]'
+	$(BIN)/python -m pip install --quiet atheris
 	$(BIN)/python bench/fuzz_readers.py -runs=1000000 -max_len=8192 -timeout=10
 
 clean:
-	rm -rf build $(VENV) *.egg-info .pytest_cache .hypothesis
+	rm -rf build dist $(VENV) *.egg-info .pytest_cache .hypothesis docs/auto_examples

@@ -12,8 +12,9 @@ UM = 1e6
 
 
 def _pyplot():
-    import matplotlib
+    from .extras import require
 
+    matplotlib = require("matplotlib")
     matplotlib.use("Agg", force=True)
     import matplotlib.pyplot as plt
 

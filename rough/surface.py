@@ -1,6 +1,6 @@
 """The data model: a measured or synthesised profile (1-D) or height map (2-D).
 
-Conventions (SPEC §3): heights are float64 metres, a profile is ``z[x]`` and a map
+Conventions (docs/conventions.rst ("Data model")): heights are float64 metres, a profile is ``z[x]`` and a map
 ``z[y, x]`` (row-major, x fastest, as in X3P). ``spacing`` is ``(dx,)`` or
 ``(dx, dy)`` in metres; the physical length is ``n * dx``. NaN marks invalid points.
 """
@@ -31,8 +31,30 @@ def check_size(shape, what):
 
 @dataclass(frozen=True)
 class Units:
-    """The units a surface's source file used for lateral (``xy``) and height (``z``)
-    values. Informational: rough always holds metres."""
+    """The units a surface's source file used for lateral and height values.
+
+    Informational only: rough always holds metres, whatever the file used. Readers
+    record the units they found; writers that can carry them (X3P, TSV, GSF, EXR)
+    pass them on.
+
+    Attributes
+    ----------
+    xy : str, default "m"
+        The unit of lateral positions in the source file (``m``, ``mm``, ``um``, ...).
+    z : str, default "m"
+        The unit of heights in the source file.
+
+    Examples
+    --------
+    >>> import rough
+    >>> rough.Units()
+    Units(xy='m', z='m')
+    >>> scan = rough.read(b"x[mm] z[um]\\n0 1.5\\n0.5 -2\\n1.0 0.5\\n")
+    >>> scan.units                             # as the file said; heights are in metres
+    Units(xy='mm', z='um')
+    >>> round(float(scan.heights[0]) * 1e6, 6)  # µm
+    1.5
+    """
 
     xy: str = "m"
     z: str = "m"
@@ -40,18 +62,89 @@ class Units:
 
 @dataclass(eq=False)
 class Surface:
-    """A profile or height map.
+    """A profile or height map: heights on a regular grid, with provenance.
 
-    Attributes:
-        heights: float64 metres, shape ``(nx,)`` or ``(ny, nx)``; NaN marks invalid points.
-        spacing: ``(dx,)`` or ``(dx, dy)``, metres, finite and positive.
-        origin: position of the first point, ``(x0,)`` or ``(x0, y0)``, metres.
-        units: the units the data came in (see :class:`Units`).
-        metadata: strings such as ``title``, ``instrument``, ``date``, ``source``.
-        history: one entry per command that made or changed the surface, oldest first:
-            ``{"command", "parameters", "version", "time"}``.
-        source_format: the format the surface was read from (a key of
-            ``rough.io.FORMATS``), or None for a surface made or changed in memory.
+    ``Surface(heights, spacing, origin=None, units=Units(), metadata={}, history=[])``
+    makes one from an array; :func:`rough.read` and the synthesis functions return
+    one. Integer and float32 heights are converted to float64; a single spacing for a
+    map is used for both axes.
+
+    Attributes
+    ----------
+    heights : numpy.ndarray of float64
+        Heights in metres, shape ``(nx,)`` for a profile (``z[x]``) or ``(ny, nx)`` for
+        a map (``z[y, x]``, x fastest, as in X3P). NaN marks invalid points.
+    spacing : tuple of float
+        ``(dx,)`` or ``(dx, dy)``, metres, finite and positive.
+    origin : tuple of float
+        Position of the first point, ``(x0,)`` or ``(x0, y0)``, metres (default zeros).
+    units : Units
+        The units the data came in (see :class:`Units`); informational.
+    metadata : dict of str
+        Strings such as ``title``, ``instrument``, ``date``, ``source``.
+    history : list of dict
+        One entry per command that made or changed the surface, oldest first:
+        ``{"command", "parameters", "version", "time"}``.
+    source_format : str or None
+        The format the surface was read from (a key of ``rough.io.FORMATS``), or None
+        for a surface made or changed in memory.
+    is_profile : bool
+        True for a profile (1-D heights), False for a map.
+    kind : str
+        ``"profile"`` or ``"map"``.
+    points : tuple of int
+        Points along each axis, x first: ``(nx,)`` or ``(nx, ny)``.
+    size : tuple of float
+        Physical size along each axis, x first, in metres (``n * spacing``).
+    valid : numpy.ndarray of bool
+        Mask of the valid (non-NaN) points, shaped like ``heights``.
+
+    Raises
+    ------
+    rough.InputError
+        For heights that are not numbers, not 1-D or 2-D, or empty, and for a spacing
+        or origin of the wrong length, not finite, or (spacing) not positive.
+
+    See Also
+    --------
+    rough.read : Read a surface from a file, standard input or bytes.
+
+    Notes
+    -----
+    ``shape``-like tuples (``points``, ``spacing``, ``size``, ``origin``) list x first,
+    while ``heights.shape`` is row-major (y first). Methods: ``positions(axis)`` (sample
+    positions, m), ``crop(x=(x0, x1), y=(y0, y1))`` (an evaluation range that includes
+    the samples nearest to its ends), ``derive(command, parameters, **changes)`` (a
+    changed copy with a history entry) and ``write(target, format=None)``.
+
+    Examples
+    --------
+    A profile of four points 0.5 mm apart, one of them invalid:
+
+    >>> import numpy as np
+    >>> import rough
+    >>> profile = rough.Surface(np.array([0.0, 1e-6, np.nan, 3e-6]), spacing=0.5e-3)
+    >>> profile
+    <Surface profile 4 points, spacing (0.0005) m, 0 history entries>
+    >>> profile.kind, profile.points, profile.size  # size in metres
+    ('profile', (4,), (0.002,))
+    >>> profile.valid.tolist()
+    [True, True, False, True]
+    >>> profile.positions().tolist()  # m
+    [0.0, 0.0005, 0.001, 0.0015]
+
+    A map: ``heights`` is ``z[y, x]``, the tuples list x first.
+
+    >>> scan = rough.read(rough.sample("rock-map.x3p"))
+    >>> scan.heights.shape, scan.points
+    ((96, 128), (128, 96))
+    >>> [f"{length * 1e3:.1f} mm" for length in scan.size]
+    ['6.4 mm', '4.8 mm']
+    >>> int(scan.valid.sum()), scan.heights.size  # a 3 × 2 patch of invalid points
+    (12282, 12288)
+    >>> part = scan.crop(x=(1e-3, 2e-3))  # from x = 1 mm to 2 mm, every row
+    >>> part.points, part.origin, part.history[-1]["command"]
+    ((21, 96), (0.001, 0.0), 'crop')
     """
 
     heights: np.ndarray
@@ -78,10 +171,12 @@ class Surface:
 
     @property
     def is_profile(self):
+        """True for a profile (1-D heights), False for a map."""
         return self.heights.ndim == 1
 
     @property
     def kind(self):
+        """``"profile"`` or ``"map"``."""
         return "profile" if self.is_profile else "map"
 
     @property

@@ -11,6 +11,12 @@ import pytest
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 
 
+def pytest_report_header():
+    import rough
+
+    return f"rough {rough.__version__} from {pathlib.Path(rough.__file__).parent}"
+
+
 def shared_folder():
     """``../shared`` beside the checkout (or $ROUGH_SHARED), or None."""
     candidate = pathlib.Path(os.environ.get("ROUGH_SHARED", ROOT.parent / "shared"))
@@ -47,7 +53,7 @@ def run():
 
 
 def assert_one_line_error(result, *fragments, status=2):
-    """A failure the way SPEC §5 wants it: the status, one line on stderr that says
+    """A failure as the command-line contract wants it (docs/conventions.rst): the status, one line on stderr that says
     what went wrong, and no traceback."""
     stderr = result.stderr.decode()
     assert result.returncode == status, stderr

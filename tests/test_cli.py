@@ -1,4 +1,5 @@
-"""The command-line contract of SPEC §5, run as a user runs it: a separate process."""
+"""The command-line contract (docs/conventions.rst, "Command-line contract"), run as a
+user runs it: a separate process."""
 
 import json
 import os
@@ -11,7 +12,7 @@ import time
 import numpy as np
 import pytest
 
-from rough import Surface
+from rough import Surface, __version__
 
 from conftest import ROOT, assert_one_line_error, rough
 from x3p_files import x3p_file
@@ -31,7 +32,7 @@ def sample(tmp_path):
 
 
 def test_version_and_help():
-    assert rough("--version", check=True).stdout.decode().startswith("rough 0.1.0")
+    assert rough("--version", check=True).stdout.decode().startswith(f"rough {__version__}\n")
     help_text = rough("--help", check=True).stdout.decode()
     assert "info" in help_text and "convert" in help_text and "bare number is in mm" in help_text
 

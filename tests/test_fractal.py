@@ -245,7 +245,7 @@ def test_resample_maps_and_gaps():
 
 
 def test_paper_fragments_fall_short_of_eq2_and_whole_length_does_not():
-    """MATH §2.5 at the paper's settings: D = 1.275, L = 80 mm, η = τ = 0.0309 mm and C
+    """docs/math.rst §2.5 at the paper's settings: D = 1.275, L = 80 mm, η = τ = 0.0309 mm and C
     from eq. (2) for Rq 0.2781 mm. Mean Rq / eq. (2) Rq: whole length 1.40 (theory
     1.41), 128-point fragments 0.22."""
     spacing, length, dimension = 0.0309e-3, 80e-3, 1.275

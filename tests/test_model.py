@@ -5,7 +5,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from rough import Surface
+from rough import Surface, __version__
 from rough.errors import InputError
 from rough.surface import history_entry
 from rough.units import format_length, metres_per, parse_length
@@ -78,7 +78,7 @@ def test_derive_appends_history_and_keeps_the_original(monkeypatch):
     derived = original.derive("detrend", {"order": 2}, heights=np.ones(4))
     assert original.history == [] and original.heights.sum() == 0
     assert derived.history == [
-        {"command": "detrend", "parameters": {"order": 2}, "version": "0.1.0", "time": "2023-11-14T22:13:20Z"}
+        {"command": "detrend", "parameters": {"order": 2}, "version": __version__, "time": "2023-11-14T22:13:20Z"}
     ]
     derived.metadata["title"] = "b"
     assert original.metadata["title"] == "a"

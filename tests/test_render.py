@@ -80,7 +80,7 @@ def ticks_out_of_contact(model, track, speed, y=-0.78e-3, period=1e-3):
 
 
 def test_dynamic_stylus_skips_a_sharp_valley_at_120_mm_s_but_not_at_20():
-    """MATH §5.5: with M = 1.85 g the stylus cannot follow a sharp edge at speed. The
+    """docs/math.rst §5.5: with M = 1.85 g the stylus cannot follow a sharp edge at speed. The
     hand is held 0.78 mm (1 N) below the rim and the slot is shallower than that, so the
     quasi-static law never loses contact: only the stylus's inertia can."""
     track = slot_track()
@@ -200,8 +200,8 @@ def test_the_hand_rests_on_the_surface_with_its_own_press():
 
 
 def test_force_spread_and_time_out_of_contact_rise_with_speed():
-    """MATH §5.5 in kind, on a profile made as the paper made its stimuli (128-point
-    fragments scaled to Rq 0.2781 mm, where MATH's figures come from). The steady hand
+    """docs/math.rst §5.5 in kind, on a profile made as the paper made its stimuli (128-point
+    fragments scaled to Rq 0.2781 mm, where the figures of docs/math.rst §5.5 come from). The steady hand
     follows at 20 mm/s and cannot at 120 mm/s."""
     track = rock_track(fragments=True)
     slow, fast = (forces(simulate(track, speed)) for speed in (0.02, 0.12))

@@ -210,9 +210,22 @@ def unplug(folder):
     }
 
 
+def scratch_mount():
+    """A folder to mount a tmpfs on (the host's root is read-only in the guest) that hides
+    none of the files this run needs: the interpreter, rough and these tests may all live
+    under /tmp (a wheel installed into a temporary environment)."""
+    needed = [pathlib.Path(p).resolve() for p in (sys.prefix, sys.exec_prefix, HERE)]
+    needed.append(pathlib.Path(sys.modules["rough"].__file__).resolve().parent)
+    for candidate in map(pathlib.Path, ("/media", "/srv", "/mnt", "/tmp")):
+        if candidate.is_dir() and not any(candidate == n or candidate in n.parents for n in needed):
+            return candidate
+    raise SystemExit("no folder to mount a tmpfs on that hides nothing this run needs")
+
+
 def main():
-    subprocess.run(["mount", "-t", "tmpfs", "tmpfs", "/tmp"], check=True)
-    folder = pathlib.Path("/tmp/rough-guest")
+    mount_point = scratch_mount()
+    subprocess.run(["mount", "-t", "tmpfs", "tmpfs", str(mount_point)], check=True)
+    folder = mount_point / "rough-guest"
     folder.mkdir()
     os.chdir(folder)
     first, second = profiles(folder)

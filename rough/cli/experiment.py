@@ -5,7 +5,7 @@ import math
 import click
 
 from .haptics import SPEED, TIME, haptic_options
-from .options import LENGTH, report_format
+from .options import LENGTH, plot_option, report_format
 from .report import emit
 
 
@@ -217,21 +217,22 @@ def _joystick_session(study, subject, haptics, contact, friction):
 @click.option(
     "--set", "set_id", type=int, help="Analyze one reference set (the paper's Tables 1 and 2 are sets 1 and 2)."
 )
-@click.option(
-    "--plot", metavar="FILE", help="Draw the percentage of answers judging each test rougher (the paper's Figures 4-5)."
-)
+@plot_option("Draw the percentage of answers judging each test rougher (the paper's Figures 4-5).")
 @report_format
 def analyze(study, set_id, plot, as_json, as_tsv):
     """Fit logit P(test judged rougher) = β0 + β_D ΔD + β_Rq ΔRq + Σ γ_s S_s to the
     answers in STUDY (ΔD, ΔRq: test minus reference, Rq in mm; one indicator per subject
     but the first) and print each coefficient with its standard error, Wald statistic
-    W = β/SE and p = 2(1 − Φ(|W|)), as the paper's Tables 1-2 do, with likelihood-ratio
+    W = β/SE and p = 2(1 − Φ(abs(W))), as the paper's Tables 1-2 do, with likelihood-ratio
     tests for D and Rq. Warns under (quasi-)separation, where Wald tests mislead.
     """
     import logging
 
     from ..experiment.analysis import answers_table, fit
     from ..experiment.design import load_study
+    from ..extras import require
+
+    require("statsmodels")
 
     loaded = load_study(study)
     result = fit(answers_table(loaded, set_id), loaded.subjects)

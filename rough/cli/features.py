@@ -3,7 +3,7 @@ slides' feature detection and Rq against evaluation length."""
 
 import click
 
-from .options import LENGTH, crop_option, report_format, surface_input
+from .options import LENGTH, crop_option, plot_option, report_format, surface_input
 from .report import emit
 
 
@@ -69,7 +69,7 @@ from .report import emit
 @click.option(
     "--vs-length", is_flag=True, help="Also report Rq against evaluation length and the slope of log Rq on log L."
 )
-@click.option("--plot", metavar="FILE", help="Draw the profile (features shaded) or map, and the amplitude density.")
+@plot_option("Draw the profile (features shaded) or map, and the amplitude density.")
 @report_format
 def features(
     surface,

@@ -2,7 +2,7 @@
 
 import click
 
-from .options import BAND, LENGTH, crop_option, report_format, surface_input
+from .options import BAND, LENGTH, crop_option, plot_option, report_format, surface_input
 from .report import emit
 
 
@@ -35,7 +35,7 @@ from .report import emit
 @click.option(
     "--psd", "psd_file", metavar="FILE", help="Write the log-binned spectrum as TSV (frequency 1/m, density, count)."
 )
-@click.option("--plot", metavar="FILE", help="Draw the spectrum on log-log axes with the fitted power law.")
+@plot_option("Draw the spectrum on log-log axes with the fitted power law.")
 @report_format
 def fit_fractal(surface, input, band, resolution, method, order, sampling, fill, psd_file, plot, as_json, as_tsv):
     """Fit the power law of INPUT's power spectrum (default: standard input): the

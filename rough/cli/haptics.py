@@ -79,6 +79,11 @@ def haptic_options(command):
         values = {name: kwargs.pop(name) for name in names}
         if values["device"] != "sim" and not values["device"].startswith("hid"):
             raise click.BadParameter(f"{values['device']!r}: use sim, hid or hid:VID:PID", param_hint="--device")
+        if values["device"].startswith("hid"):
+            from ..extras import require
+
+            require("hidraw")
+            require("hidtools")
         return command(*args, haptics=Haptics(**values), **kwargs)
 
     options = [
@@ -104,7 +109,7 @@ def haptic_options(command):
             type=MASS,
             default="1.85g",
             show_default=True,
-            help="dynamic: stylus mass M (the slides' 1.85e-6 in N·s²/mm = 1.85 g; they print 1.85e-6 g, MATH §5.3).",
+            help="dynamic: stylus mass M (the slides' 1.85e-6 read in N·s²/mm = 1.85 g; docs: Mathematics §5.3).",
         ),
         click.option(
             "--damping", type=DAMPING, default="4.6e-5N*s/mm", show_default=True, help="dynamic: stylus damping C."

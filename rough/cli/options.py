@@ -16,6 +16,20 @@ import click
 FORMAT_CHOICES = ("x3p", "exr", "gsf", "tsv", "npy")
 
 
+def plot_option(help):
+    """``--plot FILE``; checks that matplotlib (the ``plot`` extra) is installed before
+    any work starts."""
+
+    def needs_matplotlib(ctx, param, value):
+        if value is not None:
+            from ..extras import require
+
+            require("matplotlib")
+        return value
+
+    return click.option("--plot", metavar="FILE", callback=needs_matplotlib, help=help)
+
+
 class LengthType(click.ParamType):
     """A length with a unit (``0.1545mm``, ``30.9um``, ``2e-3m``) → metres."""
 

@@ -3,7 +3,7 @@
 import click
 
 from .haptics import DAMPING, FORCE, MASS, SPEED, STIFFNESS, TIME, haptic_options
-from .options import CROP, LENGTH, TIP, input_options, report_format
+from .options import CROP, LENGTH, TIP, input_options, plot_option, report_format
 from .report import emit
 
 
@@ -46,7 +46,7 @@ from .report import emit
     metavar="FILE",
     help="Write one row per tick (t x y_i h F_x F_y contact; .tsv or .npy); {speed} in the name for several speeds.",
 )
-@click.option("--plot", metavar="FILE", help="Draw the force profiles.")
+@plot_option("Draw the force profiles.")
 @report_format
 def render(
     surfaces,

@@ -2,7 +2,7 @@
 
 import click
 
-from .options import BAND, LENGTH, crop_option, report_format, surface_input
+from .options import BAND, LENGTH, crop_option, plot_option, report_format, surface_input
 from .report import emit
 
 
@@ -28,7 +28,7 @@ from .report import emit
 )
 @click.option("--sampling", type=click.Choice(["point", "band-limited"]), help="As for fit-fractal.")
 @click.option("--fill", is_flag=True, help="Fill invalid points first (biharmonic inpainting).")
-@click.option("--plot", metavar="FILE", help="Draw polar roses of C(θ) and D(θ), mirrored to 360°.")
+@plot_option("Draw polar roses of C(θ) and D(θ), mirrored to 360°.")
 @report_format
 def rose(surface, input, step, width, band, resolution, order, sampling, fill, plot, as_json, as_tsv):
     """Fit the surface dimension Ds(θ) and amplitude coefficient C(θ) of the map

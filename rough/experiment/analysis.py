@@ -1,4 +1,4 @@
-"""Analysis of paired comparisons (MATH.md §6): multiple logistic regression of "the test
+"""Analysis of paired comparisons (docs/math.rst §6): multiple logistic regression of "the test
 surface was judged rougher" on its D and Rq and on subject indicators, by maximum
 likelihood (statsmodels), with Wald statistics W = β/SE and p = 2(1 − Φ(|W|)) as the
 paper printed them, likelihood-ratio tests as a cross-check, and a warning when the
@@ -30,6 +30,55 @@ def wald_p(statistic):
 
 @dataclasses.dataclass
 class Analysis:
+    """The result of :func:`fit`: the logistic regression, as the paper's tables print it.
+
+    Attributes
+    ----------
+    coefficients : dict
+        Name → ``{"estimate", "stderr", "wald", "p", "unit"}``, for
+        ``fractal_dimension`` (per unit of D), ``rq`` (per mm of Rq), one
+        ``subject_<ID>`` per subject but the first (logit) and ``constant`` (logit);
+        ``wald`` is ``W = β/SE`` and ``p = 2(1 − Φ(|W|))`` (NaN when SE is 0).
+    n : int
+        The number of answers.
+    subjects : list of str
+        The subjects, the first being the baseline.
+    log_likelihood : float
+        Of the full model.
+    likelihood_ratio : dict
+        ``fractal_dimension`` and ``rq`` → ``{"statistic", "p"}``: likelihood-ratio
+        tests (χ², one degree of freedom) of leaving each out, a cross-check of the
+        Wald tests.
+    separation : bool
+        True when the data are (quasi-)separated (the fit did not converge, or some
+        fitted probability is within 3e-7 of certainty), where Wald tests mislead.
+    converged : bool
+        Whether the maximum-likelihood fit converged.
+    sets : list of int
+        The reference sets the answers came from.
+
+    Notes
+    -----
+    ``as_dict()`` gives the fields as a JSON-able dict.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from rough.experiment.analysis import fit
+    >>> table = {
+    ...     "rougher": np.array([0.0, 1, 1, 0, 1, 0, 1, 1]),
+    ...     "dimension": np.array([-0.075, 0.075, 0, 0, 0.075, -0.075, 0, 0.075]),
+    ...     "rq": np.array([0.0, 0, 0.07, -0.06, 0.07, -0.06, 0.07, 0]),  # mm
+    ...     "subject": ["S01"] * 8,
+    ...     "set": [1] * 8,
+    ... }
+    >>> analysis = fit(table)
+    >>> analysis.n, analysis.subjects, list(analysis.coefficients)
+    (8, ['S01'], ['fractal_dimension', 'rq', 'constant'])
+    >>> sorted(analysis.coefficients["rq"])
+    ['estimate', 'p', 'stderr', 'unit', 'wald']
+    """
+
     coefficients: dict  # name -> {"estimate", "stderr", "wald", "p", "unit"}
     n: int
     subjects: list
@@ -44,8 +93,49 @@ class Analysis:
 
 
 def answers_table(study, set_id=None):
-    """All answers of the study (optionally of one reference set) as columns: test
-    judged rougher (0/1), ΔD, ΔRq (mm), subject, set."""
+    """All answers of a study as columns for :func:`fit`.
+
+    Parameters
+    ----------
+    study : Study
+        The study, from :func:`~rough.experiment.design.load_study`.
+    set_id : int, optional
+        Only the answers of this reference set; default all.
+
+    Returns
+    -------
+    dict
+        ``rougher``: 1.0 where the test was judged rougher, else 0.0;
+        ``dimension``: ΔD and ``rq``: ΔRq in mm (test minus reference, nominal
+        values of the design), as float arrays; ``subject`` and ``set``: lists.
+
+    Raises
+    ------
+    rough.InputError
+        For answers from subjects not in the study, an unknown set, no answers yet,
+        or an answers file that does not match the trial list.
+
+    Examples
+    --------
+    >>> import pathlib, tempfile
+    >>> from rough.experiment.design import grid_design, write_study
+    >>> surfaces, sets = grid_design([(1.275, 0.2781e-3)], 0.075, 1.2593)
+    >>> folder = tempfile.TemporaryDirectory()
+    >>> place = pathlib.Path(folder.name) / "study"
+    >>> study = write_study(place, surfaces, sets, ["S01", "S02"], 5, 4e-3, 30.9e-6, 0.1545e-3)
+    >>> from rough.experiment.analysis import answers_table
+    >>> from rough.experiment.session import run_session
+    >>> for subject in study.subjects:
+    ...     _ = run_session(study, subject, lambda trial: ("first", 1.0, 1), "script")
+    >>> table = answers_table(study)
+    >>> sorted(table), table["rougher"].size
+    (['dimension', 'rougher', 'rq', 'set', 'subject'], 16)
+    >>> sorted(set(table["dimension"].round(3).tolist()))  # ΔD
+    [-0.075, 0.0, 0.075]
+    >>> sorted(set(table["rq"].round(4).tolist()))  # ΔRq, mm
+    [-0.0573, 0.0, 0.0721]
+    >>> folder.cleanup()
+    """
     rows = []
     for subject in study.subjects:
         rows += read_answers(study, subject)
@@ -73,8 +163,67 @@ def answers_table(study, set_id=None):
 
 
 def fit(table, subject_order=None):
-    """The logistic regression of ``table`` (from :func:`answers_table`, or the same
-    columns from elsewhere). The first subject (in ``subject_order``) is the baseline."""
+    """The logistic regression of "the test was judged rougher" on ΔD, ΔRq and subject.
+
+    ``logit P = β0 + β_D ΔD + β_Rq ΔRq + Σ γ_s S_s``, by maximum likelihood
+    (statsmodels' Newton), with one indicator per subject but the first.
+
+    Parameters
+    ----------
+    table : dict
+        Columns as :func:`answers_table` gives them (or the same from elsewhere):
+        ``rougher`` (0/1), ``dimension`` (ΔD) and ``rq`` (ΔRq, mm) as arrays,
+        ``subject`` and ``set`` as lists.
+    subject_order : list of str, optional
+        The order of the subjects; the first one present is the baseline. Default:
+        sorted.
+
+    Returns
+    -------
+    Analysis
+        Estimates, standard errors, Wald statistics and p-values, likelihood-ratio
+        tests, and whether the data are separated.
+
+    Raises
+    ------
+    rough.InputError
+        When ΔD or ΔRq does not vary across the trials, or the design is degenerate
+        (a predictor is a combination of others: too few trials or subjects).
+
+    Notes
+    -----
+    Wald tests mislead under (quasi-)separation (the Hauck–Donner effect);
+    ``Analysis.separation`` flags it. ML logistic regression is biased away from
+    zero in small samples.
+
+    Examples
+    --------
+    2000 simulated answers with known slopes, -4 per unit of D and 12 per mm of Rq:
+    the estimates lie within about one standard error of them.
+
+    >>> import numpy as np
+    >>> from rough.experiment.analysis import fit
+    >>> rng = np.random.default_rng(0)
+    >>> delta_d = rng.choice([-0.075, 0.0, 0.075], 2000)
+    >>> delta_rq = rng.choice([-0.06, 0.0, 0.07], 2000)  # mm
+    >>> probability = 1 / (1 + np.exp(-(0.2 - 4 * delta_d + 12 * delta_rq)))
+    >>> table = {
+    ...     "rougher": (rng.random(2000) < probability).astype(float),
+    ...     "dimension": delta_d,
+    ...     "rq": delta_rq,
+    ...     "subject": [f"S{k % 4}" for k in range(2000)],
+    ...     "set": [1] * 2000,
+    ... }
+    >>> analysis = fit(table)
+    >>> for name in ("fractal_dimension", "rq"):
+    ...     c = analysis.coefficients[name]
+    ...     print(f"{name}: {c['estimate']:.1f} ± {c['stderr']:.1f} {c['unit']}, W = {c['wald']:.1f}, ", end="")
+    ...     print(f"p < 1e-4: {c['p'] < 1e-4}")
+    fractal_dimension: -3.4 ± 0.8 1/unit of D, W = -4.4, p < 1e-4: True
+    rq: 11.8 ± 0.9 1/mm, W = 12.8, p < 1e-4: True
+    >>> analysis.n, analysis.separation, analysis.converged
+    (2000, False, True)
+    """
     subjects = [s for s in (subject_order or sorted(set(table["subject"]))) if s in set(table["subject"])]
     columns = {"fractal_dimension": table["dimension"], "rq": table["rq"]}
     for name, values in columns.items():
@@ -119,7 +268,9 @@ def fit(table, subject_order=None):
 
 
 def _logit(response, columns):
-    import statsmodels.api as sm
+    from ..extras import require
+
+    sm = require("statsmodels.api")
 
     design = np.column_stack(list(columns.values()))
     if np.linalg.matrix_rank(design) < design.shape[1]:

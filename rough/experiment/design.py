@@ -7,14 +7,14 @@ their recorded seeds), ``trials.csv`` (subject, trial, set, reference, test, fir
 second: the order and sides, randomised per subject) and, once sessions run,
 ``answers/<subject>.csv``. The analysis uses the nominal D and Rq of the design;
 ``study.json`` also records each surface's Rq as stored (``rq_measured``, after
-resampling), which differs slightly (MATH.md §6.3).
+resampling), which differs slightly (docs/math.rst §6.3).
 
 The ``costa2000`` preset is the paper's design: references D = 1.275, Rq = 0.2781 mm
 and D = 1.425, Rq = 0.75 mm, each compared with the eight neighbours of a 3 × 3 grid of
 D ± 0.075 and Rq × (1.2593)^±1, 80 mm profiles synthesised at 0.0309 mm (the
 encoder's resolution) and stored at 0.1545 mm, 14 subjects. The paper states only one
 neighbour's Rq (0.3502 mm, Rq × 1.2593 for the first set); the other levels follow the
-same ratio, an assumption (MATH.md §6.1).
+same ratio, an assumption (docs/math.rst §6.1).
 """
 
 import csv
@@ -46,7 +46,50 @@ COSTA2000 = {
 
 @dataclasses.dataclass
 class Study:
-    """A study folder's design (see the module notes); ``folder`` is where it lives."""
+    """A study folder's design, as :func:`load_study` reads it.
+
+    Attributes
+    ----------
+    folder : pathlib.Path
+        Where the study lives.
+    surfaces : dict
+        Surface id → ``{"file", "dimension", "rq", "seed", "rq_measured"}``: the
+        profile's file (relative to ``folder``), its nominal D and Rq (m), its
+        synthesis seed and its Rq as stored, after resampling (m).
+    sets : list of dict
+        ``{"id", "reference", "neighbours"}`` per reference set.
+    subjects : list of str
+        The subject ids.
+    trials : list of dict
+        Every trial, with the fields of ``TRIAL_FIELDS``: subject, trial (number),
+        set, reference, test, first, second.
+    seed : int
+        The randomisation seed of the design.
+    preset : str or None
+        The preset the design came from (``costa2000``), if any.
+
+    Notes
+    -----
+    Methods: ``surface_path(surface_id)`` (the path of a surface's file),
+    ``trials_of(subject)`` (the subject's trials in order; an InputError for an
+    unknown subject) and ``answers_path(subject)`` (``answers/<subject>.csv``).
+
+    Examples
+    --------
+    >>> import pathlib, tempfile
+    >>> from rough.experiment.design import grid_design, write_study
+    >>> surfaces, sets = grid_design([(1.275, 0.2781e-3)], 0.075, 1.2593)
+    >>> folder = tempfile.TemporaryDirectory()
+    >>> study = write_study(
+    ...     pathlib.Path(folder.name) / "study", surfaces, sets, ["S01", "S02"], seed=5,
+    ...     length=4e-3, synthesis_spacing=30.9e-6, spacing=0.1545e-3,
+    ... )
+    >>> study.subjects, len(study.trials), len(study.trials_of("S01"))
+    (['S01', 'S02'], 16, 8)
+    >>> study.surface_path("R1").name, study.answers_path("S02").name
+    ('R1.x3p', 'S02.csv')
+    >>> folder.cleanup()
+    """
 
     folder: pathlib.Path
     surfaces: dict  # id -> {"file", "dimension", "rq", "seed"}
@@ -69,8 +112,40 @@ class Study:
 
 
 def grid_design(references, dimension_step, rq_factor):
-    """Surfaces and sets for ``references`` [(D, Rq m), ...]: each with the eight
-    neighbours of its 3 × 3 grid D + {-1, 0, 1}·step, Rq × factor^{-1, 0, 1}."""
+    """The surfaces and reference sets of a grid design around each reference.
+
+    Each reference is compared with the eight neighbours of its 3 × 3 grid
+    ``D + {-1, 0, 1}·dimension_step``, ``Rq × rq_factor^{-1, 0, 1}``.
+
+    Parameters
+    ----------
+    references : list of tuple of float
+        ``[(D, Rq), ...]``: each reference's fractal dimension and RMS height (m).
+    dimension_step : float
+        The step in D between grid levels.
+    rq_factor : float
+        The ratio of Rq between grid levels.
+
+    Returns
+    -------
+    surfaces : dict
+        Surface id → ``{"dimension", "rq"}`` (Rq in m): the references ``R1``, ``R2``,
+        … and their neighbours, named like ``R1-D1.35-Rq0.3502mm``.
+    sets : list of dict
+        ``{"id", "reference", "neighbours"}`` per reference, ids from 1.
+
+    Examples
+    --------
+    The paper's first set (``COSTA2000``):
+
+    >>> from rough.experiment.design import grid_design
+    >>> surfaces, sets = grid_design([(1.275, 0.2781e-3)], dimension_step=0.075, rq_factor=0.3502 / 0.2781)
+    >>> len(surfaces), sets[0]["id"], sets[0]["reference"], len(sets[0]["neighbours"])
+    (9, 1, 'R1', 8)
+    >>> test = sets[0]["neighbours"][-1]  # one step up in D and in Rq
+    >>> test, surfaces[test]["dimension"], f"{surfaces[test]['rq'] * 1e3:.4f} mm"
+    ('R1-D1.35-Rq0.3502mm', 1.35, '0.3502 mm')
+    """
     surfaces, sets = {}, []
     for number, (dimension, rq) in enumerate(references, start=1):
         reference = f"R{number}"
@@ -127,9 +202,79 @@ def subject_ids(subjects):
 
 
 def write_study(folder, surfaces, sets, subjects, seed, length, synthesis_spacing, spacing, preset=None):
-    """Synthesise every surface (whole-length spectral synthesis with its own seed,
-    then band-limited resampling to ``spacing``) and write the study folder, atomically:
-    it appears complete or not at all. Refuses an existing non-empty folder."""
+    """Synthesise every surface and write the study folder, atomically.
+
+    Each surface is a whole-length spectral synthesis with its own seed (drawn from
+    ``seed``), scaled to its Rq, then band-limited resampling to ``spacing``. The
+    folder is staged beside its final place and renamed when complete: it appears
+    complete or not at all.
+
+    Parameters
+    ----------
+    folder : str or os.PathLike
+        The study folder: new, or an existing empty folder; its parent must exist.
+    surfaces : dict
+        Surface id → ``{"dimension", "rq"}`` (Rq in m), as from :func:`grid_design`.
+        Updated in place with each surface's ``file``, ``seed`` and ``rq_measured``
+        (its Rq as stored, m).
+    sets : list of dict
+        ``{"id", "reference", "neighbours"}``, as from :func:`grid_design`.
+    subjects : list of str
+        Subject ids (letters, digits, ``-`` and ``_``).
+    seed : int
+        Seeds the surfaces and the randomisation of each subject's trial order and
+        sides.
+    length : float
+        The profiles' length, m.
+    synthesis_spacing : float
+        The spacing the profiles are synthesised at, m (the paper's encoder
+        resolution is 30.9 µm).
+    spacing : float
+        The spacing they are stored at, m (the paper's 0.1545 mm).
+    preset : str, optional
+        The name of the preset the design came from, recorded in ``study.json``.
+
+    Returns
+    -------
+    Study
+        The study as :func:`load_study` reads it back.
+
+    Raises
+    ------
+    rough.InputError
+        For an existing non-empty folder (or a file), or a parent folder that does
+        not exist. Nothing is left behind on any failure.
+
+    Notes
+    -----
+    The folder holds ``study.json`` (the design), ``surfaces/*.x3p``, ``trials.csv``
+    (every subject compares each reference with each of its neighbours once, in a
+    random order with a random side for the test) and an empty ``answers/``.
+
+    Examples
+    --------
+    >>> import pathlib, tempfile
+    >>> import rough
+    >>> from rough.experiment.design import grid_design, write_study
+    >>> surfaces, sets = grid_design([(1.275, 0.2781e-3)], 0.075, 1.2593)
+    >>> folder = tempfile.TemporaryDirectory()
+    >>> place = pathlib.Path(folder.name) / "study"
+    >>> study = write_study(
+    ...     place, surfaces, sets, ["S01", "S02"], seed=5, length=4e-3, synthesis_spacing=30.9e-6, spacing=0.1545e-3
+    ... )
+    >>> sorted(path.name for path in place.iterdir())
+    ['answers', 'study.json', 'surfaces', 'trials.csv']
+    >>> len(list((place / "surfaces").glob("*.x3p"))), len(study.trials)  # 9 surfaces; 8 trials per subject
+    (9, 16)
+    >>> f"{study.surfaces['R1']['rq_measured'] * 1e3:.4f} mm"  # the nominal 0.2781 mm, after resampling
+    '0.2729 mm'
+    >>> try:
+    ...     write_study(place, surfaces, sets, ["S01"], 5, 4e-3, 30.9e-6, 0.1545e-3)
+    ... except rough.InputError as error:
+    ...     print(str(error).endswith("exists and is not an empty folder; choose a new study folder"))
+    True
+    >>> folder.cleanup()
+    """
     from ..fractal.resample import resample
     from ..fractal.synth import synthesize_profile
 
@@ -182,7 +327,45 @@ def write_study(folder, surfaces, sets, subjects, seed, length, synthesis_spacin
 
 
 def load_study(folder):
-    """Read and check a study folder; any fault is an InputError naming the folder."""
+    """Read and check a study folder.
+
+    Parameters
+    ----------
+    folder : str or os.PathLike
+        A folder made by :func:`write_study`.
+
+    Returns
+    -------
+    Study
+        The design, its surfaces and its trial list.
+
+    Raises
+    ------
+    rough.InputError
+        Naming the folder or file, for a folder without ``study.json``, a
+        ``study.json`` that is not valid JSON, not a ``rough-study 1`` file or an
+        incomplete design, a missing surface file, or a missing or malformed
+        ``trials.csv``.
+
+    Examples
+    --------
+    >>> import pathlib, tempfile
+    >>> import rough
+    >>> from rough.experiment.design import grid_design, load_study, write_study
+    >>> surfaces, sets = grid_design([(1.275, 0.2781e-3)], 0.075, 1.2593)
+    >>> folder = tempfile.TemporaryDirectory()
+    >>> place = pathlib.Path(folder.name) / "study"
+    >>> _ = write_study(place, surfaces, sets, ["S01"], 5, 4e-3, 30.9e-6, 0.1545e-3)
+    >>> study = load_study(place)
+    >>> study.subjects, study.seed, study.sets[0]["reference"]
+    (['S01'], 5, 'R1')
+    >>> try:
+    ...     load_study(place / "surfaces")
+    ... except rough.InputError as error:
+    ...     print(str(error).split(": ", 1)[1])
+    not a study folder (no study.json; make one with rough experiment design)
+    >>> folder.cleanup()
+    """
     folder = pathlib.Path(folder)
     path = folder / "study.json"
     if not path.is_file():

@@ -38,7 +38,44 @@ class Observer:
 
 
 def parse_observer(spec):
-    """``rq=12,dimension=-4,spread=0.5,bias=0,seed=7`` → an Observer."""
+    """A scripted observer for headless sessions, from its command-line spec.
+
+    The observer judges the test surface rougher with probability
+    ``logistic(bias + u_s + rq·ΔRq + dimension·ΔD)``, ΔRq in mm and ΔD in units of D
+    (test minus reference), ``u_s`` a per-subject intercept drawn from
+    N(0, spread²). Every draw is seeded by (seed, subject, trial), so a resumed
+    session answers as an unbroken one would.
+
+    Parameters
+    ----------
+    spec : str
+        Comma-separated ``key=value`` pairs: ``rq`` (logit per mm of Rq),
+        ``dimension`` (logit per unit of D), ``bias`` (logit), ``spread`` (logit, not
+        negative) and ``seed`` (an integer); each defaults to 0.
+
+    Returns
+    -------
+    Observer
+        With ``probability(subject, delta_dimension, delta_rq)`` (ΔRq in metres) and
+        ``judges_test_rougher(subject, trial, delta_dimension, delta_rq)``.
+
+    Raises
+    ------
+    rough.InputError
+        For an unknown key, a value that is not a number, or one that is not finite
+        (or a negative spread).
+
+    Examples
+    --------
+    >>> from rough.experiment.observer import parse_observer
+    >>> observer = parse_observer("rq=12,dimension=-4,seed=7")
+    >>> observer
+    Observer(rq=12.0, dimension=-4.0, bias=0.0, spread=0.0, seed=7)
+    >>> round(observer.probability("S01", 0.0, 0.1e-3), 4)  # Rq 0.1 mm higher: logistic(1.2)
+    0.7685
+    >>> round(observer.probability("S01", 0.075, 0.0), 4)  # D 0.075 higher: logistic(-0.3)
+    0.4256
+    """
     values = {}
     for item in filter(None, (part.strip() for part in spec.split(","))):
         key, equals, value = item.partition("=")

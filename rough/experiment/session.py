@@ -80,9 +80,62 @@ def read_answers(study, subject):
 
 
 def run_session(study, subject, present, device_name):
-    """Present every unanswered trial of ``subject`` with ``present(trial)`` →
-    ``(answer, response_time_s, toggles)`` (answer ``first`` or ``second``; None when
-    the subject stopped), saving each answer at once. Ctrl-C pauses the session."""
+    """Present every unanswered trial of a subject, saving each answer at once.
+
+    Parameters
+    ----------
+    study : Study
+        The study, from :func:`~rough.experiment.design.load_study`.
+    subject : str
+        One of ``study.subjects``.
+    present : callable
+        ``present(trial)`` → ``(answer, response_time_s, toggles)``, with ``answer``
+        ``"first"`` or ``"second"`` (the surface judged rougher), or None when the
+        subject stopped; ``trial`` is a dict with the fields of ``TRIAL_FIELDS``.
+    device_name : str
+        Recorded with each answer.
+
+    Returns
+    -------
+    Progress
+        ``answered``, ``remaining`` and ``total`` trials, and ``interrupted`` (True
+        when ``present`` returned None or Ctrl-C paused the session).
+
+    Raises
+    ------
+    rough.InputError
+        For a subject not in the study, or an answers file that is unreadable or
+        does not match the trial list.
+
+    Notes
+    -----
+    ``answers/<subject>.csv`` is rewritten whole through a temporary file and a
+    rename after every trial, so it always holds every answered trial and nothing
+    half-written; running the session again resumes at the first unanswered trial
+    without repeating one.
+
+    Examples
+    --------
+    A scripted subject who answers three trials and stops, then comes back:
+
+    >>> import pathlib, tempfile
+    >>> from rough.experiment.design import grid_design, write_study
+    >>> surfaces, sets = grid_design([(1.275, 0.2781e-3)], 0.075, 1.2593)
+    >>> folder = tempfile.TemporaryDirectory()
+    >>> study = write_study(pathlib.Path(folder.name) / "study", surfaces, sets, ["S01"], 5, 4e-3, 30.9e-6, 0.1545e-3)
+    >>> from rough.experiment.session import run_session
+    >>> script = iter(["first", "second", "first"])
+    >>> def three_then_stop(trial):
+    ...     answer = next(script, None)
+    ...     return None if answer is None else (answer, 1.5, 2)
+    >>> run_session(study, "S01", three_then_stop, "script")
+    Progress(answered=3, remaining=5, total=8, interrupted=True)
+    >>> run_session(study, "S01", lambda trial: ("first", 1.0, 1), "script")
+    Progress(answered=8, remaining=0, total=8, interrupted=False)
+    >>> len(study.answers_path("S01").read_text().splitlines())  # a header and 8 answers
+    9
+    >>> folder.cleanup()
+    """
     answers = read_answers(study, subject)
     done = {int(row["trial"]) for row in answers}
     trials = study.trials_of(subject)
@@ -131,8 +184,60 @@ def _save(path, rows):
 
 
 def simulated_presenter(study, observer, speed, model, friction, settings, **hand):
-    """Present a trial with the simulated hand: one stroke over each surface, then the
-    observer's judgement from the design's D and Rq. Response time: the strokes' time."""
+    """A ``present(trial)`` for :func:`run_session` that uses the simulated hand.
+
+    Each trial strokes the simulated hand once over each surface of the pair, then
+    asks the observer's judgement from the design's nominal D and Rq.
+
+    Parameters
+    ----------
+    study : Study
+        The study whose surfaces are presented (each read once, on first use).
+    observer : Observer
+        The scripted observer, from :func:`~rough.experiment.observer.parse_observer`.
+    speed : float
+        The stroking speed, m/s.
+    model : QuasiStatic or DynamicStylus
+        The contact model.
+    friction : object or None
+        A friction model from :func:`rough.render.parse_friction`, or None.
+    settings : Settings
+        Loop settings, as for :func:`rough.render.simulate`.
+    **hand
+        ``press``, ``hand_mass``, ``hand_damping``, ``lateral_stiffness``, passed to
+        :func:`rough.render.simulate`.
+
+    Returns
+    -------
+    callable
+        ``present(trial)`` → ``(answer, response_time_s, toggles)``: the side judged
+        rougher, the strokes' simulated time (s) and 1 toggle; None when a stroke was
+        interrupted.
+
+    Raises
+    ------
+    rough.InputError
+        (from ``present``) For a surface file that cannot be read or rendered.
+
+    Examples
+    --------
+    >>> import pathlib, tempfile
+    >>> from rough.experiment.design import grid_design, write_study
+    >>> surfaces, sets = grid_design([(1.275, 0.2781e-3)], 0.075, 1.2593)
+    >>> folder = tempfile.TemporaryDirectory()
+    >>> study = write_study(pathlib.Path(folder.name) / "study", surfaces, sets, ["S01"], 5, 4e-3, 30.9e-6, 0.1545e-3)
+    >>> from rough.experiment.observer import parse_observer
+    >>> from rough.experiment.session import run_session, simulated_presenter
+    >>> from rough.render import QuasiStatic, Settings
+    >>> observer = parse_observer("rq=12,dimension=-4,seed=7")
+    >>> present = simulated_presenter(study, observer, 0.02, QuasiStatic(), None, Settings(realtime=False))
+    >>> answer, seconds, toggles = present(study.trials[0])
+    >>> answer in ("first", "second"), f"{seconds:.3f} s", toggles  # two 3.86 mm strokes at 20 mm/s
+    (True, '0.386 s', 1)
+    >>> run_session(study, "S01", present, "sim")
+    Progress(answered=8, remaining=0, total=8, interrupted=False)
+    >>> folder.cleanup()
+    """
     from .. import read
     from ..render import Track, simulate
 

@@ -27,7 +27,7 @@ rough's resample (below the roll-off of its anti-aliasing filter).
 Cross-checks for profiles: ``variogram`` (structure function at lags 1 and 2),
 ``madogram`` (mean absolute difference at lags 1 and 2), and ``loglog`` (the
 band-limited, log-binned least-squares line through the Hann periodogram of
-MATH §1.4), with standard errors from 8 blocks.
+docs/math.rst §1.4), with standard errors from 8 blocks.
 """
 
 import dataclasses
@@ -51,7 +51,61 @@ FLAT = 1e-9  # RMS residual below this fraction of the largest height is roundin
 
 @dataclasses.dataclass
 class FractalFit:
-    """The result of a fit; lengths in metres, frequencies in 1/m."""
+    """The result of :func:`fit_fractal`; lengths in metres, frequencies in 1/m.
+
+    Attributes
+    ----------
+    fractal_dimension : float
+        D of a profile, in (1, 2), or the surface dimension Ds of a map, in (2, 3).
+    fractal_dimension_stderr : float
+        Its standard error: from the Fisher information (Whittle), or from 8 blocks
+        of the profile (``variogram``, ``madogram``, ``loglog``).
+    amplitude_coefficient : float
+        The amplitude coefficient C at ``resolution``, metres; for maps, the C of the
+        profiles through the map, so that a map and its profiles share one C.
+    amplitude_coefficient_stderr : float
+        Its standard error, metres; NaN for the cross-check methods.
+    resolution : float
+        The resolution η at which C is stated, metres.
+    psd_prefactor : float
+        The spectrum's prefactor in SI units: A = C η^(2D-3) (G at f = 1 m⁻¹) for a
+        profile, C2 for a map.
+    hurst : float
+        The Hurst exponent H: 2 - D for a profile, 3 - Ds for a map.
+    band : tuple of float
+        ``(fmin, fmax)``, the frequencies fitted, 1/m.
+    method : str
+        How D was estimated (``whittle``, ``variogram``, ``madogram``, ``loglog``, or
+        the ring-binned Whittle fit for maps).
+    window : str
+        The window applied before the transform.
+    sampling : str
+        ``"point"`` (power above the Nyquist frequency folds back) or
+        ``"band-limited"``.
+    frequencies_used : int
+        Periodogram ordinates in the fit.
+    structure_function_coefficient : float
+        Ganti & Bhushan's structure-function coefficient C_S, metres
+        (docs/math.rst §1.2).
+    profile_dimension : float or None
+        For maps, Ds - 1, the D of the profiles through the map; None for profiles.
+
+    Notes
+    -----
+    ``as_dict()`` gives the fields as a JSON-able dict (``band`` as a list, and no
+    ``profile_dimension`` for a profile).
+
+    Examples
+    --------
+    >>> import rough
+    >>> fit = rough.fit_fractal(rough.read(rough.sample("rock-profile.tsv")))  # D = 1.3
+    >>> print(f"D = {fit.fractal_dimension:.3f} ± {fit.fractal_dimension_stderr:.3f}, H = {fit.hurst:.3f}")
+    D = 1.305 ± 0.016, H = 0.695
+    >>> print(f"C = {fit.amplitude_coefficient * 1e9:.0f} nm at η = {fit.resolution * 1e6:.1f} µm")
+    C = 260 nm at η = 30.9 µm
+    >>> sorted(fit.as_dict())[:3]
+    ['amplitude_coefficient', 'amplitude_coefficient_stderr', 'band']
+    """
 
     fractal_dimension: float
     fractal_dimension_stderr: float
@@ -93,9 +147,83 @@ def default_top(surface, nyquist, sampling):
 
 
 def fit_fractal(surface, band=None, resolution=None, method="whittle", order=1, sampling=None, sector=None):
-    """D (or Ds for maps) and C of ``surface`` (see the module text). ``band`` is
-    ``(fmin, fmax)`` in 1/m (either may be None); ``resolution`` the η at which C is
-    stated (default the spacing). Invalid points must have been filled."""
+    """The fractal dimension D (Ds for maps) and amplitude coefficient C of a surface.
+
+    Parameters
+    ----------
+    surface : Surface
+        A gap-free profile or map: invalid (NaN) points must have been filled (see
+        :func:`rough.fractal.resample.fill_invalid`).
+    band : tuple of (float or None), optional
+        ``(fmin, fmax)`` in 1/m, either end None for its default: from the lowest
+        frequency (maps: the eighth ring) up to the Nyquist frequency for profiles
+        and band-limited maps, half of it for point-sampled maps, and 80 % of it
+        after rough's resample.
+    resolution : float, optional
+        The η in metres at which C is stated; default the (smaller) spacing.
+    method : {"whittle", "variogram", "madogram", "loglog"}, default "whittle"
+        The Whittle likelihood of the spectrum, or (profiles only) one of the
+        cross-checks: the structure function or the mean absolute difference at lags
+        1 and 2, or a least-squares line through the log-binned Hann periodogram.
+    order : int, default 1
+        The degree of the polynomial form removed first.
+    sampling : {"point", "band-limited"}, optional
+        Whether power above the Nyquist frequency folded back when the data were
+        sampled (``point``) or not (``band-limited``: what rough's synthesis and
+        resampling make). Default: read from the surface's history.
+    sector : tuple of float, optional
+        Maps only: ``(angle, width)`` in radians, to fit only the wavevectors within
+        ``width/2`` of ``angle`` (mod 180°).
+
+    Returns
+    -------
+    FractalFit
+        D (or Ds), C, their standard errors, and what the fit used.
+
+    Raises
+    ------
+    rough.InputError
+        For invalid points, an unknown method or sampling, a sector for a profile, a
+        method other than Whittle for a map, a surface that is flat once its form is
+        removed, or too few frequencies (8) or rings (4) in the band.
+
+    Notes
+    -----
+    Profiles: the Whittle likelihood of the periodogram of the first differences
+    under their exact spectrum, ``2A sin²(πfΔ) Σ_m |f + m/Δ|^-β`` for point samples
+    (the m = 0 term alone for band-limited data); standard errors from the Fisher
+    information. Maps: the gamma (binned Whittle) likelihood of the ring-averaged,
+    Hann-windowed periodogram, the axis lines and the lowest eight rings left out.
+    A fitted exponent at the edge of the fractal range is warned about: the data do
+    not follow a power law in the band.
+
+    Examples
+    --------
+    The sample profile was synthesised with D = 1.3; its history says it is
+    band-limited:
+
+    >>> import rough
+    >>> from rough.fractal.fit import fit_fractal
+    >>> scan = rough.read(rough.sample("rock-profile.tsv"))
+    >>> fit = fit_fractal(scan)
+    >>> fit.sampling, round(fit.fractal_dimension, 2), fit.frequencies_used
+    ('band-limited', 1.31, 1023)
+    >>> [f"{f * 1e-3:.3f}/mm" for f in fit.band]  # 1/L to the Nyquist frequency
+    ['0.016/mm', '16.173/mm']
+
+    A map (Ds = 2.3 by design) needs its invalid points filled first:
+
+    >>> from rough.fractal.resample import fill_invalid
+    >>> scan = rough.read(rough.sample("rock-map.x3p"))
+    >>> try:
+    ...     fit_fractal(scan)
+    ... except rough.InputError as error:
+    ...     print(error)
+    the spectrum needs gap-free data: this surface has invalid points (fill them with --fill)
+    >>> fit = fit_fractal(fill_invalid(scan))
+    >>> print(f"Ds = {fit.fractal_dimension:.2f} ± {fit.fractal_dimension_stderr:.2f}, D = {fit.profile_dimension:.2f}")
+    Ds = 2.33 ± 0.04, D = 1.33
+    """
     from ..metrology import detrend
 
     if method not in METHODS:
@@ -389,7 +517,7 @@ def _madogram(heights, spacing, band, resolution, sampling):
 
 
 def _loglog_estimate(heights, spacing, band):
-    """MATH §1.4: a least-squares line through the log-binned Hann periodogram over
+    """docs/math.rst §1.4: a least-squares line through the log-binned Hann periodogram over
     the band (default: leaving out k ≤ 2 and the top quarter below Nyquist).
     Returns ``(β, A, band used, frequencies used)``."""
     from .psd import log_bins

@@ -1,4 +1,5 @@
-"""The fractal (power-law) spectral model and its conventions (SPEC §6, MATH §1).
+"""The fractal (power-law) spectral model and its conventions (docs/conventions.rst
+("Fractal conventions"), docs/math.rst §1).
 
 Profiles: one-sided PSD in cycles per metre, ``Rq² = ∫ G(f) df``, with
 ``G(f) = C η^(2D-3) f^-(5-2D)`` (the paper's eq. 1): D is the fractal dimension
@@ -73,7 +74,7 @@ def map_amplitude(prefactor_value, surface_dimension, resolution):
 def structure_factor(dimension):
     """C_P / C_S: Ganti & Bhushan's structure-function coefficient C_S
     (S(τ) = C_S η^(2D-3) τ^(4-2D)) gives G with C_P = C_S · Γ(5-2D) sin(π(2-D)) /
-    (π (2π)^(4-2D)) (MATH §1.2)."""
+    (π (2π)^(4-2D)) (docs/math.rst §1.2)."""
     return (
         math.gamma(5 - 2 * dimension)
         * math.sin(math.pi * (2 - dimension))
@@ -83,7 +84,7 @@ def structure_factor(dimension):
 
 def eq2_rq(amplitude_value, dimension, resolution, length, sampling=None):
     """The paper's eq. (2): the Rq that ∫ G df from 1/L to 1/τ predicts (τ = η by
-    default). rough does not calibrate with it (MATH §2.5); it is here to compare."""
+    default). rough does not calibrate with it (docs/math.rst §2.5); it is here to compare."""
     tau = resolution if sampling is None else sampling
     exponent = 4.0 - 2.0 * dimension
     return math.sqrt(prefactor(amplitude_value, dimension, resolution) * (length**exponent - tau**exponent) / exponent)

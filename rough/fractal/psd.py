@@ -1,5 +1,5 @@
 """Power spectra: the normalised periodogram, log binning, and conversions between
-spectral conventions (SPEC §6).
+spectral conventions (docs/conventions.rst ("Fractal conventions")).
 
 rough's canonical profile PSD is one-sided in cycles per metre, ``Rq² = ∫ G(f) df``:
 ``G_k = 2 Δx |Z_k|² / (N U)`` for 0 < k < N/2 (DC and Nyquist not doubled), with Z the

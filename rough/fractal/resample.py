@@ -30,7 +30,74 @@ MAX_DENOMINATOR = 1000
 
 
 def resample(surface, spacing, fill=False):
-    """``surface`` at the new ``spacing`` (metres; one value, or (dx, dy) for maps)."""
+    """A surface at a new spacing, by band-limited (polyphase) resampling.
+
+    Profiles are resampled along x, maps along both axes. Coarsening removes what
+    the new spacing cannot hold instead of folding it back (aliasing); refining
+    interpolates band-limited and adds no power above the old Nyquist frequency.
+
+    Parameters
+    ----------
+    surface : Surface
+        A profile or map.
+    spacing : float or tuple of float
+        The new spacing, metres: one value, or ``(dx, dy)`` for maps. The ratio of
+        old to new spacing must be a fraction of integers up to 1000 (to within
+        1e-9).
+    fill : bool, default False
+        Fill invalid (NaN) points first (see :func:`fill_invalid`); without it a
+        surface with invalid points is refused.
+
+    Returns
+    -------
+    Surface
+        Heights in metres at the new spacing, with a ``resample`` history entry
+        (which :func:`~rough.fractal.fit.fit_fractal` reads to treat the result as
+        band-limited). With ``fill``, the new points nearest to an old invalid one
+        are set back to NaN.
+
+    Raises
+    ------
+    rough.InputError
+        For a spacing that is not positive, invalid points without ``fill``, a ratio
+        that is not a fraction of small integers or refines more than 1000×, fewer
+        than two points left along an axis, or a result past rough's size limit.
+
+    Notes
+    -----
+    scipy's ``resample_poly``: upsample by ``up``, low-pass with a Kaiser-windowed
+    FIR at the lower of the two Nyquist frequencies, keep every ``down``-th sample;
+    the ends are padded by linear extrapolation. The top ~20 % below the new Nyquist
+    frequency are attenuated by the filter's transition band, so fit fractal
+    parameters below that.
+
+    Examples
+    --------
+    The sample profile at five times its spacing (the paper's 0.1545 mm):
+
+    >>> import numpy as np
+    >>> import rough
+    >>> from rough.fractal.resample import resample
+    >>> scan = rough.read(rough.sample("rock-profile.tsv"))  # 2048 points at 30.9 µm
+    >>> coarse = resample(scan, 0.1545e-3)
+    >>> coarse.points, coarse.spacing, coarse.history[-1]["command"]
+    ((410,), (0.0001545,), 'resample')
+
+    A sine well below the new Nyquist frequency keeps its amplitude:
+
+    >>> x = np.arange(1000) * 1e-6
+    >>> sine = rough.Surface(1e-6 * np.sin(2 * np.pi * x / 100e-6), 1e-6)  # λ = 100 µm
+    >>> coarse = resample(sine, 5e-6)
+    >>> coarse.points, f"{np.max(np.abs(coarse.heights)) * 1e6:.2f} µm"
+    ((200,), '1.00 µm')
+
+    Invalid points must be filled, and come back as NaN:
+
+    >>> scan = rough.read(rough.sample("rock-map.x3p"))  # a 3 × 2 patch of NaN at 50 µm
+    >>> coarse = resample(scan, 100e-6, fill=True)
+    >>> coarse.points, int(np.isnan(coarse.heights).sum())
+    ((64, 48), 2)
+    """
     from scipy.signal import resample_poly
 
     targets = tuple(np.broadcast_to(np.asarray(spacing, dtype=float), (surface.heights.ndim,)))
@@ -73,8 +140,40 @@ def _ratio(old, new):
 
 
 def fill_invalid(surface):
-    """``surface`` with its invalid points filled (see :func:`filled`), recorded as a
-    ``fill`` step; unchanged when every point is valid."""
+    """A surface with its invalid (NaN) points filled.
+
+    Linear interpolation along a profile (the ends take the nearest valid value);
+    scikit-image's biharmonic inpainting in a map.
+
+    Parameters
+    ----------
+    surface : Surface
+        A profile or map with at least one valid point.
+
+    Returns
+    -------
+    Surface
+        With no NaN left, recorded as a ``fill`` history entry; the same surface,
+        unchanged, when every point is valid.
+
+    Raises
+    ------
+    rough.InputError
+        When no point is valid.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import rough
+    >>> from rough.fractal.resample import fill_invalid
+    >>> heights = np.array([0.0, 1.0, np.nan, 3.0, np.nan, np.nan, 6.0]) * 1e-6
+    >>> (fill_invalid(rough.Surface(heights, 10e-6)).heights * 1e6).round(9).tolist()  # µm
+    [0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0]
+    >>> scan = rough.read(rough.sample("rock-map.x3p"))
+    >>> filled = fill_invalid(scan)
+    >>> int(np.isnan(filled.heights).sum()), filled.history[-1]["command"]
+    (0, 'fill')
+    """
     if not np.isnan(surface.heights).any():
         return surface
     return surface.derive("fill", {}, heights=filled(surface))

@@ -1,4 +1,4 @@
-"""Fractal surfaces by spectral synthesis in one transform (MATH §2.2-2.3).
+"""Fractal surfaces by spectral synthesis in one transform (docs/math.rst §2.2-2.3).
 
 The whole length (or area) is made in one inverse FFT (maps in single precision,
 profiles in double): the coefficients are those of
@@ -15,7 +15,7 @@ from numpy's PCG64 in fixed blocks, whatever the number of threads that draw the
 The paper's method (``fragments``) is kept for comparison: independent 128-point
 syntheses at the encoder resolution, each shifted to start where the last ended. A
 fragment holds no wavelength longer than itself, which is why the paper's profiles
-fell short of their eq. (2) Rq (MATH §2.5).
+fell short of their eq. (2) Rq (docs/math.rst §2.5).
 """
 
 import logging
@@ -37,11 +37,83 @@ PAPER_RESOLUTION = 0.0309e-3
 
 
 def synthesize_profile(points, spacing, dimension, amplitude=None, rq=None, resolution=None, seed=None, rolloff=None):
-    """A fractal profile of ``points`` samples at ``spacing`` (metres) with fractal
-    dimension D (1-2) and either the amplitude coefficient ``amplitude`` (metres, at
-    ``resolution``, default the spacing) or the RMS height ``rq`` (metres). With a
-    ``rolloff`` wavelength (metres) the spectrum is flat at longer wavelengths: the
-    surface is self-affine only below that scale."""
+    """A fractal profile by spectral synthesis of the whole length in one transform.
+
+    The coefficients are those of the FFT of white Gaussian noise (no DC term, a
+    real Nyquist term) shaped by the square root of ``G(f) = C η^(2D-3) f^-(5-2D)``,
+    so the realised spectrum has exactly the requested expectation.
+
+    Parameters
+    ----------
+    points : int
+        The number of samples.
+    spacing : float
+        The sample spacing, metres.
+    dimension : float
+        The fractal dimension D, in (1, 2).
+    amplitude : float, optional
+        The amplitude coefficient C at ``resolution``, metres. Give this or ``rq``.
+    rq : float, optional
+        The RMS height, metres: the realisation (its mean removed) is scaled to this
+        Rq exactly. Give this or ``amplitude``.
+    resolution : float, optional
+        The resolution η at which ``amplitude`` is stated, metres; default the
+        spacing.
+    seed : int, optional
+        The random seed; the same seed gives bit-identical heights. Default: a fresh
+        random seed, recorded in the history.
+    rolloff : float, optional
+        A wavelength, metres, beyond which the spectrum is flat: the profile is
+        self-affine only below that scale.
+
+    Returns
+    -------
+    Surface
+        A gap-free profile (heights in metres) of period ``points * spacing``,
+        band-limited at the Nyquist frequency, with a title and a ``synth`` history
+        entry recording every parameter and the seed.
+
+    Raises
+    ------
+    rough.InputError
+        For D outside (1, 2), both or neither of ``amplitude`` and ``rq``, an
+        ``amplitude``, ``rq`` or ``resolution`` that is not positive, or more points
+        than rough's limit (2²⁸). ``points`` and ``spacing`` are not checked: give
+        at least two points and a positive spacing.
+
+    See Also
+    --------
+    synthesize_map : The same for maps.
+    synthesize_fragments : The paper's method, for comparison.
+
+    Notes
+    -----
+    For a profile, ``E[Rq²] = Σ G(f_k)/L + G(f_N)/(2L)`` exactly over the harmonics
+    ``f_k = k/L`` of the length L (docs/math.rst §2.5): the paper's eq. (2), an
+    integral, is not what a finite realisation's variance is.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from rough.fractal.synth import synthesize_profile
+    >>> profile = synthesize_profile(4096, 10e-6, 1.5, rq=1e-6, seed=7)  # 41 mm at 10 µm
+    >>> profile
+    <Surface profile 4096 points, spacing (1e-05) m, 1 history entries>
+    >>> f"{np.std(profile.heights) * 1e6:.6f} µm"  # exactly the Rq asked for
+    '1.000000 µm'
+    >>> profile.metadata["title"]
+    'synthetic fractal, D = 1.5, Rq 1 µm, seed 7'
+    >>> again = synthesize_profile(4096, 10e-6, 1.5, rq=1e-6, seed=7)
+    >>> bool(np.array_equal(profile.heights, again.heights))  # the same seed, the same heights
+    True
+
+    Given C, a fit finds it back (within about one standard error):
+
+    >>> from rough.fractal.fit import fit_fractal
+    >>> fit = fit_fractal(synthesize_profile(4096, 10e-6, 1.5, amplitude=100e-9, seed=7))
+    >>> print(f"C = {fit.amplitude_coefficient * 1e9:.0f} ± {fit.amplitude_coefficient_stderr * 1e9:.0f} nm")
+    C = 105 ± 5 nm
+    """
     beta = model.profile_exponent(dimension)
     resolution = _amplitude_choice(amplitude, rq, resolution, spacing)
     check_size((points,), "the profile")
@@ -68,13 +140,75 @@ def synthesize_profile(points, spacing, dimension, amplitude=None, rq=None, reso
 def synthesize_map(
     points, spacing, dimension, amplitude=None, rq=None, resolution=None, seed=None, anisotropy=None, rolloff=None
 ):
-    """A fractal map of ``points = (nx, ny)`` at ``spacing = (dx, dy)`` with surface
-    dimension Ds (2-3) and the profile-equivalent amplitude coefficient ``amplitude``
-    (or the RMS height ``rq``). ``anisotropy = (Ds1, C1, Ds2, C2, angle)`` gives Ds and
-    C along the wavevector direction ``angle`` (radians from +x, counter-clockwise)
-    and along the direction at right angles; in between, Ds and log C follow
-    cos²/sin² of the angle, so the spectrum is P2 = C2(θ) |f|^-(8-2Ds(θ)). A
-    ``rolloff`` wavelength makes the spectrum flat at longer wavelengths."""
+    """A fractal map by spectral synthesis of the whole area in one transform.
+
+    The spectrum is ``P2 = C2 |f|^-(8-2Ds)``, with C2 set by the profile-equivalent
+    amplitude coefficient C (a map and its profiles share one C). The map is made
+    in single precision, far below any spectrum's dynamic range, and returned as
+    float64.
+
+    Parameters
+    ----------
+    points : tuple of int
+        ``(nx, ny)``, the number of samples along x and y.
+    spacing : tuple of float
+        ``(dx, dy)``, metres.
+    dimension : float
+        The surface dimension Ds, in (2, 3); ignored with ``anisotropy``.
+    amplitude : float, optional
+        The profile-equivalent amplitude coefficient C at ``resolution``, metres.
+        Give this or ``rq`` (or ``anisotropy``).
+    rq : float, optional
+        The RMS height Sq, metres: the realisation (its mean removed) is scaled to
+        this exactly.
+    resolution : float, optional
+        The η at which C is stated, metres; default the smaller spacing.
+    seed : int, optional
+        The random seed; the same seed gives bit-identical heights, whatever the
+        number of threads. Default: a fresh random seed, recorded in the history.
+    anisotropy : tuple of float, optional
+        ``(Ds1, C1, Ds2, C2, angle)``: Ds and C (metres) along the wavevector
+        direction ``angle`` (radians from +x, counter-clockwise: the direction in
+        which heights vary) and along the direction at right angles. In between, Ds
+        and log C follow cos²/sin² of the angle, so the spectrum is
+        ``P2 = C2(θ) |f|^-(8-2Ds(θ))``. Not with ``rq``.
+    rolloff : float, optional
+        A wavelength, metres, beyond which the spectrum is flat.
+
+    Returns
+    -------
+    Surface
+        A gap-free map, heights ``z[y, x]`` in metres of shape ``(ny, nx)``,
+        periodic and band-limited, with a title and a ``synth`` history entry.
+
+    Raises
+    ------
+    rough.InputError
+        For Ds outside (2, 3), both or neither of ``amplitude`` and ``rq``,
+        ``anisotropy`` with ``rq``, an ``amplitude``, ``rq`` or ``resolution`` that
+        is not positive, or more points than rough's limit (16384 × 16384).
+        ``points`` and ``spacing`` are not checked.
+
+    See Also
+    --------
+    synthesize_profile : The same for profiles.
+    rough.fractal.rose.rose : Measure D and C against direction.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from rough.fractal.fit import fit_fractal
+    >>> from rough.fractal.synth import synthesize_map
+    >>> scan = synthesize_map((256, 128), (10e-6, 10e-6), 2.4, amplitude=100e-9, seed=3)
+    >>> scan.heights.shape, scan.heights.dtype  # z[y, x]
+    ((128, 256), dtype('float64'))
+    >>> fit = fit_fractal(scan)
+    >>> print(f"Ds = {fit.fractal_dimension:.2f} ± {fit.fractal_dimension_stderr:.2f}")
+    Ds = 2.42 ± 0.02
+    >>> sq = synthesize_map((64, 64), (10e-6, 10e-6), 2.4, rq=1e-6, seed=3)
+    >>> f"{np.std(sq.heights) * 1e6:.6f} µm"  # exactly the Sq asked for
+    '1.000000 µm'
+    """
     nx, ny = points
     dx, dy = spacing
     if anisotropy is not None:
@@ -113,9 +247,63 @@ def synthesize_fragments(
     fragment=PAPER_FRAGMENT,
     as_printed=False,
 ):
-    """The paper's method: ``fragment``-point syntheses (each periodic, with no
-    wavelength longer than the fragment), each shifted to start where the previous
-    one ended. ``as_printed`` also applies the printed (k+1) index shift."""
+    """A fractal profile by the paper's method, kept for comparison.
+
+    Independent ``fragment``-point syntheses (each periodic, with no wavelength
+    longer than the fragment), each shifted to start where the previous one ended.
+    A warning says that this drops every wavelength longer than a fragment, so the
+    profile's Rq falls well short of the paper's eq. (2) (docs/math.rst §2.5).
+
+    Parameters
+    ----------
+    points : int
+        The number of samples.
+    spacing : float
+        The sample spacing, metres (the paper's encoder resolution is 30.9 µm).
+    dimension : float
+        The fractal dimension D, in (1, 2).
+    amplitude : float, optional
+        The amplitude coefficient C at ``resolution``, metres. Give this or ``rq``.
+    rq : float, optional
+        The RMS height, metres, to which the whole profile is scaled exactly.
+    resolution : float, optional
+        The η at which ``amplitude`` is stated, metres; default the spacing.
+    seed : int, optional
+        The random seed; default a fresh one, recorded in the history.
+    fragment : int, default 128
+        Points per fragment, as in the paper.
+    as_printed : bool, default False
+        Also apply the printed (k+1) index shift of the paper's formula.
+
+    Returns
+    -------
+    Surface
+        A gap-free profile, heights in metres, with a ``synth`` history entry
+        recording ``fragments``.
+
+    Raises
+    ------
+    rough.InputError
+        As :func:`synthesize_profile`.
+
+    See Also
+    --------
+    synthesize_profile : Whole-length synthesis, the default.
+
+    Examples
+    --------
+    With the same C, the fragments hold far less height variation than the
+    whole-length synthesis:
+
+    >>> import numpy as np
+    >>> from rough.fractal.synth import synthesize_fragments, synthesize_profile
+    >>> paper = synthesize_fragments(2048, 30.9e-6, 1.3, amplitude=260e-9, seed=1)
+    >>> whole = synthesize_profile(2048, 30.9e-6, 1.3, amplitude=260e-9, seed=1)
+    >>> f"Rq {np.std(paper.heights) * 1e6:.0f} µm against {np.std(whole.heights) * 1e6:.0f} µm"
+    'Rq 148 µm against 611 µm'
+    >>> paper.history[-1]["parameters"]["fragments"]
+    128
+    """
     beta = model.profile_exponent(dimension)
     resolution = _amplitude_choice(amplitude, rq, resolution, spacing)
     check_size((points,), "the profile")
@@ -134,7 +322,7 @@ def synthesize_fragments(
     heights = _scaled(np.concatenate(pieces)[:points], rq)
     log.warning(
         "fragments of %d points (%.4g mm) drop every wavelength longer than a fragment: the profile's Rq "
-        "falls well short of eq. (2) (MATH §2.5); use the default whole-length synthesis",
+        "falls well short of eq. (2) (docs: Mathematics §2.5); use the default whole-length synthesis",
         fragment,
         fragment * spacing * 1e3,
     )

@@ -3,9 +3,17 @@
 The input format is sniffed from the content (files and standard input alike); the
 output format follows ``format=`` or the file extension, and a stream gets X3P.
 
-    >>> from rough.io import read, write
-    >>> scan = read("scan.x3p")
-    >>> write(scan, "scan.gsf")
+>>> import pathlib, tempfile
+>>> from rough import sample
+>>> from rough.io import read, write
+>>> scan = read(sample("rock-map.x3p"))
+>>> scan.source_format, scan.heights.shape
+('x3p', (96, 128))
+>>> with tempfile.TemporaryDirectory() as folder:
+...     write(scan, pathlib.Path(folder) / "scan.gsf")  # the format from the extension
+...     again = read(pathlib.Path(folder) / "scan.gsf")
+>>> again.source_format, again.heights.shape
+('gsf', (96, 128))
 
 Formats (one module each): X3P (ISO 25178-72), OpenEXR, GSF (Gwyddion Simple Field),
 text (TSV/CSV columns, Dektak CSV, Gwyddion text export, x y z grids), NPY, and
@@ -92,8 +100,62 @@ class ReadOptions:
 def read(source, *, spacing=None, unit=None, verify=True):
     """Read a surface from a path, ``'-'`` (standard input), a binary stream or bytes.
 
-    Raises InputError (a FormatError for malformed files) whose message starts with
-    the file name. Invalid points become NaN.
+    The format is sniffed from the content, not the name; gzip-compressed data are
+    unpacked first.
+
+    Parameters
+    ----------
+    source : str, os.PathLike, bytes or binary file object
+        A path, ``'-'`` for standard input, an open binary stream, or the file's bytes.
+    spacing : float or tuple of float, optional
+        ``dx`` or ``(dx, dy)`` in metres (one value serves both axes), for data that
+        carry none (NPY, a text column of heights, a plain matrix); it also overrides
+        a file's own spacing.
+    unit : str, optional
+        The length unit of text values that name none (``mm``, ``um``, ...); default
+        metres.
+    verify : bool, default True
+        Check X3P checksums; False reads a file whose checksums fail or are missing,
+        with a warning.
+
+    Returns
+    -------
+    Surface
+        Heights in metres (float64), with the file's spacing, origin, units, metadata
+        and history; ``metadata["source"]`` names the source and ``source_format`` the
+        format read.
+
+    Raises
+    ------
+    rough.InputError
+        For a file that cannot be read or used, with a message that starts with the
+        file name; a :class:`~rough.errors.FormatError` for malformed files, and for
+        files holding fewer than two points or no valid point.
+
+    Notes
+    -----
+    Invalid points become NaN: X3P's valid-point mask, ``nan`` and ``BAD`` in text,
+    ``BAD`` points of SDF files, and infinite heights (Alicona writes ``+inf``).
+
+    Examples
+    --------
+    >>> import rough
+    >>> scan = rough.read(rough.sample("rock-profile.tsv"))
+    >>> scan.source_format, scan.heights.shape, scan.spacing  # spacing in metres
+    ('tsv', (2048,), (3.09e-05,))
+
+    Bytes work too; text names its units in the column names or a ``# unit:`` line,
+    and ``nan`` or ``BAD`` mark invalid points:
+
+    >>> text = b"x[mm]\\tz[um]\\n0\\t1.5\\n0.5\\tnan\\n1.0\\t-2\\n1.5\\tBAD\\n"
+    >>> (rough.read(text).heights * 1e6).round(6).tolist()  # µm
+    [1.5, nan, -2.0, nan]
+
+    A bare column of heights needs a spacing:
+
+    >>> column = rough.read(b"0.1\\n0.2\\n0.4\\n", spacing=1e-3, unit="um")
+    >>> column.spacing, (column.heights * 1e9).round(6).tolist()  # m, nm
+    ((0.001,), [100.0, 200.0, 400.0])
     """
     name, data = _slurp(source)
     options = ReadOptions(spacing=_spacing_tuple(spacing), unit=unit, verify=verify)
@@ -157,8 +219,51 @@ def describe(format_name):
 
 
 def write(surface, target, format=None):
-    """Write ``surface`` to a path (atomically) or a binary stream. ``format`` defaults
-    to the path's extension, and to X3P for streams."""
+    """Write ``surface`` to a path (atomically) or a binary stream.
+
+    Parameters
+    ----------
+    surface : Surface
+        The surface to write; NaN points are written as each format marks invalid
+        points (X3P's valid-point mask, ``nan`` in TSV and NPY, NaN in GSF and EXR).
+    target : str, os.PathLike or binary file object
+        A path, ``'-'`` for standard output, or an open binary stream.
+    format : {"x3p", "exr", "gsf", "tsv", "npy"}, optional
+        Defaults to the path's extension (``.x3p``, ``.exr``, ``.gsf``, ``.tsv`` or
+        ``.txt``, ``.npy``), and to X3P for streams.
+
+    Raises
+    ------
+    rough.InputError
+        When the format cannot be told from the extension, or is unknown.
+
+    Notes
+    -----
+    A path is written to a hidden temporary file beside it and renamed when
+    complete, so a failed or interrupted write never leaves a half-written file.
+    X3P and TSV keep the heights exactly (float64); GSF and EXR store float32; NPY
+    keeps no spacing, metadata or history.
+
+    Examples
+    --------
+    >>> import pathlib, tempfile
+    >>> import numpy as np
+    >>> import rough
+    >>> scan = rough.read(rough.sample("rock-map.x3p"))
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     rough.write(scan, pathlib.Path(folder) / "scan.x3p")
+    ...     again = rough.read(pathlib.Path(folder) / "scan.x3p")
+    >>> bool(np.array_equal(again.heights, scan.heights, equal_nan=True))  # NaN points too
+    True
+
+    A binary stream gets X3P unless ``format`` says otherwise:
+
+    >>> import io
+    >>> buffer = io.BytesIO()
+    >>> rough.write(scan, buffer, format="gsf")
+    >>> buffer.getvalue()[:21]
+    b'Gwyddion Simple Field'
+    """
     from .atomic import atomic_output
 
     if isinstance(target, (str, os.PathLike)) and os.fspath(target) != "-":
@@ -166,8 +271,11 @@ def write(surface, target, format=None):
         with atomic_output(target) as stream:
             _module(chosen).write(surface, stream)
     else:
-        stream = sys.stdout.buffer if target == "-" else target
-        if stream is sys.stdout.buffer:
+        standard_output = getattr(sys.stdout, "buffer", None)  # absent in some notebook kernels
+        stream = standard_output if target == "-" else target
+        if stream is None:
+            raise InputError("standard output takes no binary data here; write to a file or a binary stream")
+        if stream is standard_output:
             widen_pipe(sys.stdout)
         _module(format or "x3p").write(surface, stream)
 

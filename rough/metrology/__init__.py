@@ -1,9 +1,15 @@
 """Metrology: form removal, ISO 16610 Gaussian filters, ISO 4287/25178-2 parameters,
 the source slides' feature detection and the scale dependence of Rq.
 
-    >>> from rough.metrology import detrend, parameters
-    >>> roughness = detrend(scan, order=2, cutoff=0.8e-3)     # form, then λc = 0.8 mm
-    >>> parameters(roughness)["Ra"]
+Every function takes and returns SI units (metres) and leaves invalid (NaN) points
+out of fits and statistics; surfaces it returns are NaN where the input was.
+
+>>> import rough
+>>> from rough.metrology import detrend, parameters
+>>> scan = rough.read(rough.sample("rock-profile.tsv"))
+>>> roughness = detrend(scan, order=2, cutoff=0.8e-3)  # form, then λc = 0.8 mm
+>>> f"Ra = {parameters(roughness)['Ra'] * 1e6:.2f} µm"
+'Ra = 16.91 µm'
 """
 
 import logging
@@ -49,13 +55,79 @@ __all__ = [
 
 
 def detrend(surface, order=2, cutoff=None, keep="roughness", ends="trim"):
-    """Remove the least-squares polynomial form of degree ``order`` and, with a
-    ``cutoff`` (metres), split what is left with the ISO 16610-21/61 Gaussian filter.
+    """Remove the polynomial form and, with a cut-off, split off the waviness.
 
-    ``keep`` chooses the output: ``roughness`` (the default: the form-free surface, or
-    its roughness with a cut-off), ``waviness`` (the Gaussian mean line; needs a
-    cut-off) or ``form`` (the fitted polynomial). ``ends`` is ``trim`` (drop λc/2 at
-    each end) or ``correct`` (keep the full length). NaN stays NaN.
+    Removes the least-squares polynomial form of degree ``order`` and, with a
+    ``cutoff``, splits what is left with the ISO 16610-21 (profiles) or ISO 16610-61
+    (maps) Gaussian filter.
+
+    Parameters
+    ----------
+    surface : Surface
+        A profile or map; NaN points are left out of the fit and the filter.
+    order : int, default 2
+        Degree of the polynomial form (maps: total degree in x and y), as the source
+        slides remove ``a0 + a1 x + a2 x²``; 0 removes the mean, 1 a line or plane.
+    cutoff : float, optional
+        The filter's cut-off wavelength λc in metres; None (the default) removes only
+        the form.
+    keep : {"roughness", "waviness", "form"}, default "roughness"
+        ``roughness``: the form-free surface, or its roughness with a cut-off;
+        ``waviness``: the Gaussian mean line of the form-free surface (needs a
+        cut-off); ``form``: the fitted polynomial.
+    ends : {"trim", "correct"}, default "trim"
+        With a cut-off: ``trim`` drops λc/2 at each end, where ISO 16610-21 calls the
+        filter unreliable; ``correct`` keeps the full length with the kernel
+        renormalised over the data present (ISO 16610-28's end correction).
+
+    Returns
+    -------
+    Surface
+        Heights in metres, with a ``detrend`` (and, with a cut-off, a ``filter``)
+        history entry. NaN stays NaN.
+
+    Raises
+    ------
+    rough.InputError
+        For an unknown ``keep``, ``waviness`` without a cut-off, too few valid points
+        for the polynomial, or a cut-off longer than the data (or, with
+        ``ends="trim"``, too long to leave two points).
+
+    See Also
+    --------
+    remove_form, split, polynomial_form
+
+    Notes
+    -----
+    The polynomial is fitted on the valid points only, in a Legendre basis on
+    centred, scaled coordinates (docs/conventions.rst ("Metrology conventions")).
+    The filter is a normalised convolution, so NaN points neither spread nor bias the
+    mean line.
+
+    Examples
+    --------
+    >>> import rough
+    >>> from rough.metrology import detrend
+    >>> scan = rough.read(rough.sample("rock-profile.tsv"))
+    >>> levelled = detrend(scan)  # the quadratic form removed
+    >>> [entry["command"] for entry in levelled.history]
+    ['synth', 'detrend']
+
+    With a cut-off of 0.8 mm, λc/2 = 0.4 mm is trimmed at each end (13 points of
+    30.9 µm), unless the ends are corrected:
+
+    >>> roughness = detrend(scan, order=2, cutoff=0.8e-3)
+    >>> roughness.points, f"{roughness.origin[0] * 1e3:.4f} mm"
+    ((2022,), '0.4017 mm')
+    >>> detrend(scan, order=2, cutoff=0.8e-3, ends="correct").points
+    (2048,)
+
+    Invalid points stay invalid:
+
+    >>> import numpy as np
+    >>> scan = rough.read(rough.sample("rock-map.x3p"))
+    >>> int(np.isnan(detrend(scan, order=1).heights).sum())
+    6
     """
     if keep not in KEEP:
         raise InputError(f"keep must be one of {', '.join(KEEP)}, not {keep!r}")
@@ -71,13 +143,83 @@ def detrend(surface, order=2, cutoff=None, keep="roughness", ends="trim"):
 
 
 def parameters(surface, cutoff=None, ends="trim", sampling_lengths=5, slope="2point", along=None, jrc_spacing=0.5e-3):
-    """ISO parameters of a profile (Ra … JRC) or map (Sa … Std), in SI units, on the
-    data as given with the mean removed, or on the roughness at ``cutoff``.
+    """ISO parameters of a profile (Ra … JRC) or map (Sa … Std), in SI units.
 
-    ``along="x"`` or ``"y"`` evaluates a map as the set of its profiles in that
-    direction, each with its own mean: RMS quantities (Rq, Rdq, Z2) combine as the
-    quadratic mean over profiles (pooling the points, as SurfaceTopography's
-    ``rms_height_from_profile`` does), the others as the arithmetic mean.
+    Computed on the data as given with the mean of the valid points removed (no
+    levelling: detrend first to remove form), or on the roughness at ``cutoff``.
+
+    Parameters
+    ----------
+    surface : Surface
+        A profile or map; NaN points are left out of every parameter (slopes use
+        pairs of neighbouring valid points).
+    cutoff : float, optional
+        A Gaussian filter cut-off λc in metres: the parameters are then those of the
+        roughness (:func:`split`). None (the default) evaluates the data as given.
+    ends : {"trim", "correct"}, default "trim"
+        How the filter treats the ends (see :func:`split`); only with ``cutoff``.
+    sampling_lengths : int, default 5
+        Profiles: the number of equal sampling lengths that Rp, Rv and Rz are
+        averaged over (ISO 4287/4288).
+    slope : {"2point", "7point"}, default "2point"
+        Forward differences, or ISO 4287's seven-point derivative, for Rdq, Sdq, Sdr.
+    along : {None, "x", "y"}, optional
+        Evaluate a map as the set of its profiles in that direction, each with its
+        own mean, and combine them.
+    jrc_spacing : float, default 0.5e-3
+        Profiles: the spacing in metres at which Z2 (and so JRC) is evaluated.
+
+    Returns
+    -------
+    dict of str to float
+        Keyed as :data:`PROFILE` for a profile (or a map with ``along``) and
+        :data:`AREAL` for a map, each value in the unit given there (metres, 1/m,
+        %, degrees, or a pure number). NaN (with one warning naming the parameters
+        and the reason) for a parameter that is undefined for the data.
+
+    Raises
+    ------
+    rough.InputError
+        For a surface with no valid points, a bad ``slope`` or ``along``, too many
+        sampling lengths, or a cut-off the data cannot take.
+
+    See Also
+    --------
+    profile_parameters, areal_parameters
+
+    Notes
+    -----
+    With ``along``, RMS quantities (Rq, Rdq, Z2) combine as the quadratic mean over
+    profiles (pooling the points, as SurfaceTopography's ``rms_height_from_profile``
+    does), the others as the arithmetic mean; profiles with fewer than two valid
+    points are left out. Definitions: docs/conventions.rst ("Metrology conventions").
+
+    Examples
+    --------
+    >>> import rough
+    >>> from rough.metrology import PROFILE, detrend, parameters
+    >>> scan = rough.read(rough.sample("rock-profile.tsv"))
+    >>> values = parameters(detrend(scan, order=2))
+    >>> list(values) == list(PROFILE)
+    True
+    >>> print(f"Ra {values['Ra'] * 1e6:.1f} µm, Rq {values['Rq'] * 1e6:.1f} µm, Rku {values['Rku']:.2f}")
+    Ra 219.2 µm, Rq 273.7 µm, Rku 2.65
+
+    Ra/Rq is close to √(2/π) = 0.798, as for Gaussian heights. With a cut-off the
+    parameters are those of the roughness:
+
+    >>> round(values["Ra"] / values["Rq"], 3)
+    0.801
+    >>> f"{parameters(scan, cutoff=0.8e-3)['Rq'] * 1e6:.2f} µm"
+    '20.92 µm'
+
+    A map gives the areal parameters, over its valid points:
+
+    >>> scan = rough.read(rough.sample("rock-map.x3p"))
+    >>> f"Sq {parameters(scan)['Sq'] * 1e6:.1f} µm"
+    'Sq 100.0 µm'
+    >>> f"Rq {parameters(scan, along='x')['Rq'] * 1e6:.1f} µm"  # rows, each about its own mean
+    'Rq 93.7 µm'
     """
     evaluated = surface if cutoff is None else split(surface, cutoff, "roughness", ends)
     if surface.is_profile:

@@ -1,6 +1,6 @@
 """The source slides' feature detection: "Low pass filtered profile. Compute RMS
 amplitude (Rq) of high frequency information. Features are heights over 2·Rq, plus
-30 % of lateral distance." (MATH.md §4.5)
+30 % of lateral distance." (docs/math.rst §4.5)
 
 1. The Gaussian mean line ``w`` of the profile (ISO 16610-21, cut-off λc, ends kept
    by the renormalised kernel) is the low-pass profile; ``r = z - w`` the
@@ -32,6 +32,35 @@ POLARITIES = ("peaks", "pits", "both")
 
 @dataclasses.dataclass(frozen=True)
 class Feature:
+    """One feature that :func:`detect_features` found: a peak or a pit of a profile.
+
+    Attributes
+    ----------
+    kind : str
+        ``"peak"`` or ``"pit"``.
+    position : float
+        Where the mean line's height is largest in magnitude within the feature,
+        metres along x.
+    start, end : float
+        The first and last positions the feature spans, metres along x.
+    height : float
+        The mean line's height at ``position`` about the profile's mean, metres;
+        positive for a peak, negative for a pit.
+    prominence : float
+        Metres above the higher of the lowest points of the mean line on either side
+        within the feature (for a pit, below the lower of the highest points); zero
+        for a feature whose extreme lies at its own start or end.
+    width : float
+        ``end - start``, metres.
+
+    Examples
+    --------
+    >>> from rough.metrology import Feature
+    >>> bump = Feature("peak", position=10e-3, start=8.5e-3, end=11.5e-3, height=33e-6, prominence=32e-6)
+    >>> f"{bump.width * 1e3:.1f} mm"
+    '3.0 mm'
+    """
+
     kind: str
     position: float
     start: float
@@ -41,12 +70,79 @@ class Feature:
 
     @property
     def width(self):
+        """``end - start``, metres."""
         return self.end - self.start
 
 
 def detect_features(surface, cutoff=2.5e-3, k=2.0, extension=0.3, polarity="both", mode="B"):
-    """The features of a profile (see the module text). Returns ``(features, info)``
-    with ``info`` holding ``rq_high_frequency`` and ``threshold`` (metres)."""
+    """The features of a profile: heights over 2·Rq of the high-frequency part.
+
+    The source slides' detection: "Low pass filtered profile. Compute RMS amplitude
+    (Rq) of high frequency information. Features are heights over 2·Rq, plus 30 % of
+    lateral distance."
+
+    Parameters
+    ----------
+    surface : Surface
+        A profile. NaN points are ignored by the filter and never start or end a
+        feature; heights are measured from the mean of the valid points.
+    cutoff : float, default 2.5e-3
+        The Gaussian cut-off λc in metres that makes the low-pass profile (the mean
+        line, ends kept by the renormalised kernel).
+    k : float, default 2.0
+        The threshold in units of ``Rq_hf``, the RMS of the high-frequency part (the
+        profile less its mean line, over the profile less λc/2 at each end).
+    extension : float, default 0.3
+        Mode B: each run is widened by this fraction of its width (half on each
+        side). Mode A: this times the base width (metres per metre) is added to the
+        threshold.
+    polarity : {"both", "peaks", "pits"}, default "both"
+        Which features to look for.
+    mode : {"B", "A"}, default "B"
+        ``B``: a feature is a run where the mean line stays beyond ``±k·Rq_hf``,
+        widened by ``extension``; overlapping widened runs of one polarity merge.
+        ``A``: a local extreme of the mean line whose height exceeds ``k·Rq_hf +
+        extension·d``, ``d`` its base width between the bounding extremes of the
+        opposite kind; it spans that base (this rejects wide gentle undulations).
+
+    Returns
+    -------
+    features : list of Feature
+        Sorted by position.
+    info : dict
+        ``rq_high_frequency`` (Rq_hf) and ``threshold`` (k·Rq_hf), metres.
+
+    Raises
+    ------
+    rough.InputError
+        For a map, an unknown mode or polarity, or a cut-off the profile cannot take.
+
+    Examples
+    --------
+    A Gaussian bump 50 µm high (σ = 0.5 mm) at x = 10 mm on 1 µm of noise: one
+    peak, at the bump, whose mean-line height is what a 2.5 mm filter keeps of it.
+
+    >>> import numpy as np
+    >>> import rough
+    >>> from rough.metrology import detect_features
+    >>> rng = np.random.default_rng(1)
+    >>> x = np.arange(2000) * 10e-6  # 20 mm at 10 µm
+    >>> heights = 50e-6 * np.exp(-0.5 * ((x - 10e-3) / 0.5e-3) ** 2) + 1e-6 * rng.standard_normal(x.size)
+    >>> features, info = detect_features(rough.Surface(heights, 10e-6))
+    >>> [(f.kind, f"{f.position * 1e3:.2f} mm", f"{f.height * 1e6:.1f} µm") for f in features]
+    [('peak', '10.00 mm', '33.3 µm')]
+    >>> round(info["threshold"] / info["rq_high_frequency"], 9)  # k = 2
+    2.0
+
+    The sample rock profile:
+
+    >>> scan = rough.read(rough.sample("rock-profile.tsv"))
+    >>> features, info = detect_features(scan)
+    >>> len(features), sorted({f.kind for f in features})
+    (9, ['peak', 'pit'])
+    >>> f"threshold {info['threshold'] * 1e6:.1f} µm"
+    'threshold 95.6 µm'
+    """
     if not surface.is_profile:
         raise InputError("feature detection works on profiles; this is a map")
     if mode not in MODES or polarity not in POLARITIES:

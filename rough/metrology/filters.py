@@ -39,13 +39,95 @@ def gaussian_kernel(spacing, cutoff):
 
 
 def transmission(wavelength, cutoff):
-    """The mean line's amplitude transmission of a sine of ``wavelength``."""
+    """The Gaussian mean line's amplitude transmission of a sine of a given wavelength.
+
+    ``exp(-π (α λc / λ)²)`` with ``α = √(ln 2 / π)``: 50 % at the cut-off. The
+    roughness transmits the rest, one minus this.
+
+    Parameters
+    ----------
+    wavelength : float or array_like of float
+        Wavelength(s) λ of the sine, metres.
+    cutoff : float
+        The cut-off λc, metres.
+
+    Returns
+    -------
+    float or numpy.ndarray
+        The fraction of the amplitude that the mean line (waviness) keeps, in [0, 1],
+        shaped like ``wavelength``.
+
+    Examples
+    --------
+    >>> from rough.metrology import transmission
+    >>> round(float(transmission(0.8e-3, 0.8e-3)), 6)  # at λ = λc
+    0.5
+    >>> transmission([0.08e-3, 8e-3], 0.8e-3).round(4).tolist()  # λc / 10 and 10 λc
+    [0.0, 0.9931]
+    """
     return np.exp(-np.pi * (ALPHA * cutoff / np.asarray(wavelength, dtype=float)) ** 2)
 
 
 def mean_line(surface, cutoff):
-    """The Gaussian mean line (waviness) of ``surface`` at cut-off ``cutoff``
-    (metres), at every point, as an array; NaN where the input is NaN."""
+    """The Gaussian mean line (waviness) of a surface at every point.
+
+    ISO 16610-21 for profiles, and its separable areal form, ISO 16610-61, for maps.
+
+    Parameters
+    ----------
+    surface : Surface
+        A profile or map. NaN points are left out: the mean line at each point is
+        the weighted mean of the valid points within reach.
+    cutoff : float
+        The cut-off wavelength λc, metres; at least two samples and at most the
+        data's shortest side.
+
+    Returns
+    -------
+    numpy.ndarray
+        The mean line in metres, shaped like the heights, over the full length (the
+        kernel renormalised near the ends); NaN where the input is NaN.
+
+    Raises
+    ------
+    rough.InputError
+        For a cut-off that is not positive, longer than the data or shorter than two
+        samples.
+
+    See Also
+    --------
+    split : The roughness or waviness as a surface, with the ends trimmed.
+    transmission : The mean line's amplitude transmission of a sine.
+
+    Notes
+    -----
+    The weighting function ``exp(-π (x / (α λc))²) / (α λc)`` is sampled at the
+    spacing, truncated at ±λc and normalised; as a normalised convolution,
+    ``(s * z·v) / (s * v)`` with ``v`` the validity mask, NaN points neither spread
+    nor bias the mean line.
+
+    Examples
+    --------
+    A sine of wavelength λc keeps half its amplitude:
+
+    >>> import numpy as np
+    >>> import rough
+    >>> from rough.metrology import mean_line
+    >>> x = np.arange(4000) * 1e-6  # 4 mm at 1 µm
+    >>> sine = rough.Surface(1e-6 * np.sin(2 * np.pi * x / 0.8e-3), 1e-6)
+    >>> line = mean_line(sine, 0.8e-3)
+    >>> f"{np.max(np.abs(line[1000:3000])) * 1e6:.3f} µm"  # away from the ends
+    '0.500 µm'
+
+    A constant passes unchanged, and an invalid point stays invalid without
+    disturbing its neighbours:
+
+    >>> heights = np.full(100, 2e-6)
+    >>> heights[50] = np.nan
+    >>> line = mean_line(rough.Surface(heights, 10e-6), 0.1e-3)
+    >>> int(np.isnan(line).sum()), bool(np.allclose(line[~np.isnan(line)], 2e-6, rtol=1e-12, atol=0))
+    (1, True)
+    """
     from scipy.signal import oaconvolve
 
     heights = surface.heights
@@ -69,9 +151,61 @@ def mean_line(surface, cutoff):
 
 
 def split(surface, cutoff, keep="roughness", ends="trim"):
-    """The roughness (``surface`` minus its Gaussian mean line) or the waviness (the
-    mean line) of ``surface``, as a new surface with a history entry. ``ends`` is
-    ``"trim"`` (drop λc/2 at each end) or ``"correct"`` (keep the full length)."""
+    """The roughness or the waviness of a surface, by the Gaussian filter.
+
+    Parameters
+    ----------
+    surface : Surface
+        A profile or map; NaN points are left out of the mean line (see
+        :func:`mean_line`).
+    cutoff : float
+        The cut-off wavelength λc, metres.
+    keep : {"roughness", "waviness"}, default "roughness"
+        ``roughness``: the surface less its Gaussian mean line; ``waviness``: the
+        mean line.
+    ends : {"trim", "correct"}, default "trim"
+        ``trim`` drops λc/2 at each end (rounded up to whole samples), where ISO
+        16610-21 regards the filter as unreliable, and moves the origin to match;
+        ``correct`` keeps the full length with the kernel renormalised over the data
+        present.
+
+    Returns
+    -------
+    Surface
+        Heights in metres, with a ``filter`` history entry (standard, cut-off, keep,
+        ends). NaN where the input is NaN.
+
+    Raises
+    ------
+    rough.InputError
+        For an unknown ``keep`` or ``ends``, a cut-off the data cannot take, or data
+        too short to keep two points once λc/2 is trimmed at each end.
+
+    See Also
+    --------
+    detrend : Form removal, then this filter.
+
+    Examples
+    --------
+    A long wave (8 mm, 10 µm) and a short one (80 µm, 1 µm), split at λc = 0.8 mm:
+    the waviness keeps 99.31 % of the long wave, and the roughness the short wave
+    with the 0.69 % of the long one that the mean line misses.
+
+    >>> import numpy as np
+    >>> import rough
+    >>> from rough.metrology import split
+    >>> x = np.arange(8000) * 1e-6  # 8 mm at 1 µm
+    >>> long, short = 10e-6 * np.sin(2 * np.pi * x / 8e-3), 1e-6 * np.sin(2 * np.pi * x / 80e-6)
+    >>> scan = rough.Surface(long + short, 1e-6)
+    >>> waviness = split(scan, 0.8e-3, keep="waviness")
+    >>> roughness = split(scan, 0.8e-3)
+    >>> roughness.points, f"{roughness.origin[0] * 1e3:.1f} mm"  # 0.4 mm trimmed at each end
+    ((7200,), '0.4 mm')
+    >>> f"{np.max(np.abs(waviness.heights)) * 1e6:.2f} µm"
+    '9.93 µm'
+    >>> f"{np.max(np.abs(roughness.heights - short[400:-400])) * 1e6:.3f} µm"
+    '0.069 µm'
+    """
     if keep not in ("roughness", "waviness"):
         raise InputError(f"keep must be roughness or waviness, not {keep!r}")
     if ends not in ENDS:

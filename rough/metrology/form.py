@@ -1,4 +1,5 @@
-"""Form removal: the least-squares polynomial of order N (SPEC §7; the slides remove
+"""Form removal: the least-squares polynomial of order N (docs/conventions.rst
+("Metrology conventions"); the slides remove
 ``Y(x) = a0 + a1 x + a2 x²``).
 
 Profiles: a polynomial of degree N in x. Maps: all terms ``x^i y^j`` with
@@ -17,10 +18,56 @@ from ..errors import InputError
 
 
 def polynomial_form(surface, order=2):
-    """The least-squares polynomial of total degree ``order`` fitted to the valid
-    points of ``surface``, evaluated everywhere (an array shaped like the heights).
+    """The least-squares polynomial form of a surface, evaluated at every point.
 
-    Raises InputError when the valid points cannot determine that many terms.
+    Parameters
+    ----------
+    surface : Surface
+        A profile or map. The polynomial is fitted to its valid points only; NaN
+        points are left out of the fit.
+    order : int, default 2
+        The total degree: profiles, a polynomial of degree ``order`` in x; maps, all
+        terms ``x^i y^j`` with ``i + j <= order``.
+
+    Returns
+    -------
+    numpy.ndarray
+        The form in metres, shaped like ``surface.heights`` and evaluated everywhere,
+        at the invalid points too.
+
+    Raises
+    ------
+    rough.InputError
+        For a negative order, or when the valid points cannot determine that many
+        terms (too few distinct x positions, or rows and columns for a map).
+
+    See Also
+    --------
+    remove_form : The surface less this form.
+
+    Notes
+    -----
+    Coordinates are centred and scaled to [-1, 1] and the basis is Legendre
+    polynomials, so the normal equations stay well conditioned at high orders.
+
+    Examples
+    --------
+    A quadratic is its own form, found from the valid points and evaluated at the
+    invalid one as well:
+
+    >>> import numpy as np
+    >>> import rough
+    >>> from rough.metrology import polynomial_form
+    >>> x = np.arange(11) * 0.1e-3  # 1 mm at 0.1 mm
+    >>> z = 1e-6 + 2e-3 * x - 5.0 * x**2  # metres
+    >>> z[4] = np.nan
+    >>> form = polynomial_form(rough.Surface(z, 0.1e-3), order=2)
+    >>> form.shape
+    (11,)
+    >>> bool(np.nanmax(np.abs(form - z)) < 1e-18)
+    True
+    >>> f"{form[4] * 1e6:.4f} µm"  # 1 + 0.8 - 0.8 µm at x = 0.4 mm
+    '1.0000 µm'
     """
     along_y, coefficients, along_x = form_factors(surface, order)
     return (along_y @ coefficients @ along_x.T).reshape(surface.heights.shape)
@@ -61,8 +108,46 @@ def form_factors(surface, order=2):
 
 
 def remove_form(surface, order=2):
-    """``surface`` minus its least-squares polynomial form of degree ``order``,
-    fitted on the valid points; NaN stays NaN. Appends a ``detrend`` history entry."""
+    """A surface less its least-squares polynomial form.
+
+    Parameters
+    ----------
+    surface : Surface
+        A profile or map; the form is fitted on its valid points only.
+    order : int, default 2
+        The total degree of the polynomial (see :func:`polynomial_form`).
+
+    Returns
+    -------
+    Surface
+        The residual heights in metres, with a ``detrend`` history entry recording
+        ``order``. NaN stays NaN.
+
+    Raises
+    ------
+    rough.InputError
+        When the valid points cannot determine the polynomial.
+
+    See Also
+    --------
+    detrend : Form removal and the Gaussian filter in one call.
+
+    Examples
+    --------
+    A tilted plane with an invalid point levels to zero:
+
+    >>> import numpy as np
+    >>> import rough
+    >>> from rough.metrology import remove_form
+    >>> y, x = np.mgrid[0:4, 0:5] * 1e-3  # a 5 × 4 grid at 1 mm
+    >>> heights = 3e-6 + 0.01 * x - 0.02 * y
+    >>> heights[1, 2] = np.nan
+    >>> levelled = remove_form(rough.Surface(heights, 1e-3), order=1)
+    >>> int(np.isnan(levelled.heights).sum()), bool(np.nanmax(np.abs(levelled.heights)) < 1e-15)
+    (1, True)
+    >>> levelled.history[-1]["command"], levelled.history[-1]["parameters"]
+    ('detrend', {'order': 1})
+    """
     residual = surface.heights - polynomial_form(surface, order)
     return surface.derive("detrend", {"order": order}, heights=residual)
 

@@ -119,8 +119,80 @@ def slopes(heights, spacing, method="2point", axis=-1):
 
 
 def profile_parameters(surface, sampling_lengths=5, slope="2point", jrc_spacing=0.5e-3, peak_band=0.05):
-    """ISO 4287 parameters of a profile (see the module text for the definitions).
-    Returns a dict of floats in SI units keyed as ``PROFILE``."""
+    """ISO 4287/4288 parameters of a profile, and Tse & Cruden's Z2 and JRC.
+
+    On the data as given, about the mean of the valid points (no levelling, no
+    filter: detrend or filter first if you want them).
+
+    Parameters
+    ----------
+    surface : Surface
+        A profile. NaN points are left out: amplitude parameters use the valid
+        points, slopes pairs of neighbouring valid points, RSm and the peak count
+        close up the gaps, and Z2 interpolates linearly between valid points.
+    sampling_lengths : int, default 5
+        The number of equal sampling lengths over which Rp, Rv and Rz are taken and
+        averaged (ISO 4287/4288).
+    slope : {"2point", "7point"}, default "2point"
+        Forward differences (SurfaceTopography's and surfalize's definition), or
+        ISO 4287's seven-point derivative on interior points, for Rdq.
+    jrc_spacing : float, default 0.5e-3
+        The spacing in metres at which the profile is point-sampled for Z2 (the data
+        spacing when that is coarser).
+    peak_band : float, default 0.05
+        Half-width of the band about the mean line for the peak count, as a fraction
+        of Rz (ISO 4287/Amd.1's RPc rule).
+
+    Returns
+    -------
+    dict of str to float
+        Keyed as :data:`PROFILE`: Ra, Rq, Rt, Rp, Rv, Rz, RSm (m); Rsk, Rku, Rdq,
+        Z2, JRC (pure numbers); ``peak_density`` (1/m). NaN where a parameter is
+        undefined: Rsk and Rku of a constant profile, RSm with no complete profile
+        element, Z2 over fewer than three JRC spacings, JRC unless Z2 > 0.
+
+    Raises
+    ------
+    rough.InputError
+        For a profile with no valid points, an unknown ``slope``, fewer than 7
+        points for the seven-point slope, or more sampling lengths than half the
+        points.
+
+    See Also
+    --------
+    rough.metrology.parameters : The same with a cut-off, for maps, and with warnings.
+
+    Notes
+    -----
+    Rz is Rp + Rv averaged over the sampling lengths, not the ten-point Rz; Rku is
+    the kurtosis (3 for a Gaussian), not the excess. RSm is the mean width of the
+    profile elements between upward mean-line crossings, with ISO 4287's 10 % of Rz
+    height discrimination applied as a hysteresis band and elements narrower than
+    1 % of the sampling length merged. JRC = 32.2 + 32.47 log10(Z2).
+
+    Examples
+    --------
+    A sine of amplitude a = 1 µm and wavelength 100 µm over 40 whole periods:
+    Rq = a/√2, Ra = 2a/π, Rku = 1.5, Rz = 2a, RSm = the wavelength, and Rdq close to
+    the RMS of the slope, 2πa/(λ√2) = 0.0444:
+
+    >>> import numpy as np
+    >>> import rough
+    >>> from rough.metrology import profile_parameters
+    >>> x = np.arange(4000) * 1e-6  # 4 mm at 1 µm
+    >>> sine = rough.Surface(1e-6 * np.sin(2 * np.pi * x / 100e-6), 1e-6)
+    >>> values = profile_parameters(sine)
+    >>> print(f"Rq {values['Rq'] * 1e6:.4f} µm, Ra {values['Ra'] * 1e6:.3f} µm, Rku {values['Rku']:.3f}")
+    Rq 0.7071 µm, Ra 0.636 µm, Rku 1.500
+    >>> print(f"Rz {values['Rz'] * 1e6:.3f} µm, RSm {values['RSm'] * 1e6:.1f} µm, Rdq {values['Rdq']:.4f}")
+    Rz 2.000 µm, RSm 100.0 µm, Rdq 0.0444
+
+    Invalid points are left out: a whole period of them leaves Rq as it was.
+
+    >>> sine.heights[100:200] = np.nan
+    >>> f"{profile_parameters(sine)['Rq'] * 1e6:.4f} µm"
+    '0.7071 µm'
+    """
     z = surface.heights
     dx = surface.spacing[0]
     valid = ~np.isnan(z)
@@ -149,8 +221,78 @@ def profile_parameters(surface, sampling_lengths=5, slope="2point", jrc_spacing=
 
 
 def areal_parameters(surface, slope="2point", threshold=0.2):
-    """ISO 25178-2 parameters of a map (see the module text for the definitions).
-    Returns a dict of floats in SI units keyed as ``AREAL``."""
+    """ISO 25178-2 areal parameters of a map.
+
+    On the data as given, about the mean of the valid points (no levelling, no
+    filter: detrend or filter first if you want them).
+
+    Parameters
+    ----------
+    surface : Surface
+        A map. NaN points are left out: amplitude parameters use the valid points,
+        gradients pairs of neighbouring valid points, the autocorrelation pairs of
+        valid points only (no filling); for Std's spectrum they are set to the mean.
+    slope : {"2point", "7point"}, default "2point"
+        Forward differences, or ISO 4287's seven-point derivative, for Sdq and Sdr.
+    threshold : float, default 0.2
+        The autocorrelation level that defines Sal and Str.
+
+    Returns
+    -------
+    dict of str to float
+        Keyed as :data:`AREAL`: Sa, Sq, Sp, Sv, Sz, Sal (m); Ssk, Sku, Sdq, Str (pure
+        numbers); Sdr (%); Std (degrees). NaN where a parameter is undefined: Ssk,
+        Sku, Sal, Str and Std of a constant map; Str when the autocorrelation does not
+        fall to ``threshold`` within half the map in some direction (with a warning
+        giving its upper bound).
+
+    Raises
+    ------
+    rough.InputError
+        For a map with no valid points, an unknown ``slope``, or fewer than 7 points
+        along an axis for the seven-point slope.
+
+    See Also
+    --------
+    rough.metrology.parameters : The same with a cut-off, and with warnings.
+
+    Notes
+    -----
+    Sal is the shortest lag at which the autocorrelation falls to ``threshold`` and
+    Str that over the longest such lag among all directions, over lags up to half
+    the map. Std is the lay direction (where the ridges run), counter-clockwise from
+    +x in [0°, 180°), perpendicular to the wavevector of the largest angular power of
+    the Hann-windowed spectrum.
+
+    Examples
+    --------
+    A tilted plane has Sdq equal to its slope and Sdr = 100 (√(1 + slope²) - 1) %:
+
+    >>> import math
+    >>> import numpy as np
+    >>> import rough
+    >>> from rough.metrology import areal_parameters
+    >>> y, x = np.mgrid[0:64, 0:64] * 10e-6  # 0.64 mm square at 10 µm
+    >>> values = areal_parameters(rough.Surface(0.01 * x, 10e-6))
+    >>> round(values["Sdq"], 9), round(values["Sdr"], 9), round(100 * (math.sqrt(1 + 0.01**2) - 1), 9)
+    (0.01, 0.004999875, 0.004999875)
+
+    Grooves that run along y (heights vary along x, wavelength 160 µm, 1 µm
+    amplitude) have Sq ≈ 1/√2 µm and lay direction 90°; their texture outlasts half
+    the map along y, so Str is undefined:
+
+    >>> rng = np.random.default_rng(0)
+    >>> grooves = 1e-6 * np.sin(2 * np.pi * x / 160e-6) + 0.05e-6 * rng.standard_normal(x.shape)
+    >>> values = areal_parameters(rough.Surface(grooves, 10e-6))
+    >>> print(f"Sq {values['Sq'] * 1e6:.2f} µm, Std {values['Std']:.0f}°, Str {values['Str']}")
+    Sq 0.71 µm, Std 90°, Str nan
+
+    On the sample map (Sq 0.1 mm by design), over its valid points:
+
+    >>> values = areal_parameters(rough.read(rough.sample("rock-map.x3p")))
+    >>> print(f"Sq {values['Sq'] * 1e6:.1f} µm, Sal {values['Sal'] * 1e3:.2f} mm, Str {values['Str']:.2f}")
+    Sq 100.0 µm, Sal 0.86 mm, Str 0.73
+    """
     z = surface.heights
     dx, dy = surface.spacing
     valid = ~np.isnan(z)
@@ -177,8 +319,35 @@ def areal_parameters(surface, slope="2point", threshold=0.2):
 
 
 def amplitude_density(surface, bins=50):
-    """The amplitude probability density of the valid heights about their mean:
-    ``(bin centres in m, density in 1/m)``."""
+    """The amplitude probability density of the heights about their mean.
+
+    Parameters
+    ----------
+    surface : Surface
+        A profile or map; only its valid (non-NaN) points are counted.
+    bins : int, default 50
+        The number of equal-width height bins, spanning the valid heights.
+
+    Returns
+    -------
+    centres : numpy.ndarray
+        The bin centres, metres, about the mean of the valid heights.
+    density : numpy.ndarray
+        The probability density in 1/m (a histogram normalised so that it integrates
+        to 1 over the bins).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import rough
+    >>> from rough.metrology import amplitude_density
+    >>> scan = rough.read(rough.sample("rock-map.x3p"))  # 6 invalid points
+    >>> centres, density = amplitude_density(scan, bins=20)
+    >>> centres.shape, density.shape
+    ((20,), (20,))
+    >>> round(float(np.sum(density) * (centres[1] - centres[0])), 9)  # integrates to 1
+    1.0
+    """
     values = surface.heights[~np.isnan(surface.heights)]
     density, edges = np.histogram(values - values.mean(), bins=bins, density=True)
     return (edges[:-1] + edges[1:]) / 2, density

@@ -1,6 +1,6 @@
 """Scale dependence of the RMS height: Rq measured over shorter and shorter
 evaluation lengths (the slides' "σ ∝ L^(1/2)", Sayles & Thomas 1978; in general
-σ ∝ L^(2-D) for a self-affine profile, MATH.md §4.6).
+σ ∝ L^(2-D) for a self-affine profile, docs/math.rst §4.6).
 
 The profile is cut into non-overlapping windows of each length L (halving from the
 whole length down to 16 points); each window's mean is removed, and Rq(L) is the
@@ -18,8 +18,61 @@ MIN_WINDOW = 16
 
 
 def rq_versus_length(surface):
-    """``{"length": [...], "Rq": [...], "windows": [...], "hurst", "fractal_dimension"}``
-    with lengths in metres (x side for maps) and Rq (Sq for maps) in metres."""
+    """Rq over shorter and shorter evaluation lengths, and the slope of log Rq on log L.
+
+    The profile (map) is cut into non-overlapping windows (squares for maps) of each
+    length L, halving from the whole length (the shorter side of a map) down to 16
+    points; each window's mean is removed and Rq(L) is the RMS over all windows.
+
+    Parameters
+    ----------
+    surface : Surface
+        A profile or map, at least 32 points along each axis; NaN points are left
+        out of each window's mean and of the RMS.
+
+    Returns
+    -------
+    dict
+        ``length``: the window lengths, metres (the x side for maps), longest first;
+        ``Rq`` (``Sq`` for maps): the RMS height at each, metres; ``windows``: how
+        many windows each; ``hurst``: the slope H of the least-squares line of log Rq
+        on log L; ``fractal_dimension``: 2 - H for a profile, 3 - H for a map.
+
+    Raises
+    ------
+    rough.InputError
+        For fewer than 32 points along an axis.
+
+    Notes
+    -----
+    For a self-affine profile σ ∝ L^(2-D) (docs/math.rst §4.6). Removing each
+    window's mean biases H low over short windows, so D comes out high: treat the
+    result as a cross-check of :func:`rough.fractal.fit.fit_fractal`, not a
+    substitute for it.
+
+    Examples
+    --------
+    A random walk (Brownian motion, H = 0.5) has D = 1.5:
+
+    >>> import numpy as np
+    >>> import rough
+    >>> from rough.metrology import rq_versus_length
+    >>> rng = np.random.default_rng(0)
+    >>> walk = rough.Surface(np.cumsum(rng.standard_normal(2**14)) * 1e-7, 1e-6)
+    >>> result = rq_versus_length(walk)
+    >>> result["windows"][:4], round(result["fractal_dimension"], 1)
+    ([1, 2, 4, 8], 1.5)
+
+    On the sample profile (2048 points at 30.9 µm) the windows run from the whole
+    63.3 mm down to 16 points:
+
+    >>> scan = rough.read(rough.sample("rock-profile.tsv"))
+    >>> result = rq_versus_length(scan)
+    >>> [f"{length * 1e3:.2f}" for length in result["length"][::7]], result["windows"][-1]  # mm
+    (['63.28', '0.49'], 128)
+    >>> f"Rq {result['Rq'][0] * 1e6:.0f} µm over the whole length"
+    'Rq 280 µm over the whole length'
+    """
     heights = surface.heights
     n = min(heights.shape)
     sizes = []

@@ -1,4 +1,4 @@
-"""Contact between the stylus and the profile (MATH.md §5.2), in SI units.
+"""Contact between the stylus and the profile (docs/math.rst §5.2), in SI units.
 
 Forces are those on the stylus and so on the hand: F_y up positive, F_x along +x.
 Both models return ``(F_x, F_y, contact)`` from the stylus position ``x``, the surface
@@ -25,13 +25,47 @@ import math
 import numpy as np
 
 STIFFNESS = 1280.0  # N/m: the paper's 1.28 N/mm
-STYLUS_MASS = 1.85e-3  # kg: the slides' "1.85e-6" read in N·s²/mm (MATH.md §5.3)
+STYLUS_MASS = 1.85e-3  # kg: the slides' "1.85e-6" read in N·s²/mm (docs/math.rst §5.3)
 STYLUS_DAMPING = 0.046  # N·s/m: the slides' 4.6e-5 N/(mm/s)
 MAX_FORCE = 8.9  # N: the Impulse Engine 2000
 
 
 class QuasiStatic:
-    """The penalty wall along the profile with Minsky's lateral-gradient term."""
+    """The penalty wall along the profile with Minsky's lateral-gradient term.
+
+    The paper's experiment, with the stylus's mass and damping negligible:
+    ``F_y = K (h - y)`` while the hand is at or below the surface (``y <= h``), else 0,
+    and ``F_x = -F_y h'``: the lateral force resists climbing. ``step(x, h, slope,
+    curvature, y, vx, vy, ax)`` returns ``(F_x, F_y, contact)`` (N, N, bool), the force
+    on the stylus and so on the hand; ``reset()`` does nothing (no state).
+
+    Parameters
+    ----------
+    stiffness : float, default 1280.0
+        The contact stiffness K, N/m (the paper's 1.28 N/mm).
+
+    Attributes
+    ----------
+    stiffness : float
+        K, N/m.
+
+    Raises
+    ------
+    ValueError
+        For a stiffness that is not positive.
+
+    Examples
+    --------
+    One micrometre into a surface that rises with slope 0.1:
+
+    >>> from rough.render import QuasiStatic
+    >>> model = QuasiStatic()
+    >>> fx, fy, contact = model.step(0.0, 1e-6, 0.1, 0.0, 0.0, 0.0, 0.0, 0.0)
+    >>> print(f"F_x {fx * 1e3:.3f} mN, F_y {fy * 1e3:.3f} mN, contact {contact}")
+    F_x -0.128 mN, F_y 1.280 mN, contact True
+    >>> model.step(0.0, 0.0, 0.1, 0.0, 1e-6, 0.0, 0.0, 0.0)  # above the surface
+    (0.0, 0.0, False)
+    """
 
     def __init__(self, stiffness=STIFFNESS):
         if not stiffness > 0:
@@ -50,7 +84,77 @@ class QuasiStatic:
 
 
 class DynamicStylus:
-    """The stylus with mass and damping, stepped once per servo ``period`` (s)."""
+    """The stylus with mass and damping, hanging from the hand on a spring and damper.
+
+    In contact the stylus's tip follows the surface and the constraint force is
+    ``F = M ÿ_s - K (y - y_s) - C (ẏ - ẏ_s)`` with ``ÿ_s = h'' ẋ² + h' ẍ``; contact is
+    lost when that force would pull (F < 0), and regained, plastically, when the tip
+    reaches the surface again. In free flight the stylus is integrated exactly
+    (zero-order hold) in sub-steps, stable for any M, K and C at any loop rate. The
+    hand feels the coupling force ``K (y_s - y) + C (ẏ_s - ẏ)``. ``step(x, h, slope,
+    curvature, y, vx, vy, ax)`` returns ``(F_x, F_y, contact)`` (N, N, bool);
+    ``reset(y=None)`` puts the stylus at rest at height ``y``, free, or with no ``y``
+    on the surface.
+
+    Parameters
+    ----------
+    stiffness : float, default 1280.0
+        The spring K between hand and stylus, N/m (1.28 N/mm).
+    mass : float, default 1.85e-3
+        The stylus mass M, kg (the slides' "1.85e-6" read in N·s²/mm).
+    damping : float, default 0.046
+        The damper C, N·s/m (the slides' 4.6e-5 N/(mm/s)).
+    period : float, default 1e-3
+        The servo period it is stepped at, s.
+    substeps : int, default 10
+        Sub-steps per period in free flight.
+
+    Attributes
+    ----------
+    stiffness, mass, damping : float
+        K (N/m), M (kg) and C (N·s/m).
+    substeps : int
+        Sub-steps per period.
+    substep : float
+        ``period / substeps``, s.
+    position, velocity : float
+        The stylus's height (m) and vertical velocity (m/s).
+    touching : bool
+        Whether the stylus is on the surface.
+
+    Raises
+    ------
+    ValueError
+        For a stiffness, mass, period or substeps that is not positive, or a
+        negative damping.
+
+    Notes
+    -----
+    h'' is the mean curvature over the path of the last tick (the change of slope
+    over the distance moved), so that a corner narrower than one tick's travel still
+    loads the stylus instead of slipping between two samples of h''.
+
+    Examples
+    --------
+    Resting on a flat surface with the hand 1 mm below the tip, the spring pushes
+    up with K × 1 mm:
+
+    >>> from rough.render import DynamicStylus
+    >>> model = DynamicStylus()
+    >>> model.touching
+    True
+    >>> fx, fy, contact = model.step(0.0, 0.0, 0.0, 0.0, -1e-3, 0.0, 0.0, 0.0)
+    >>> round(fy, 9), contact  # N
+    (1.28, True)
+
+    Stroking a flat track with the simulated hand, it settles at the hand's press:
+
+    >>> import numpy as np
+    >>> from rough.render import Track, forces, simulate
+    >>> result = simulate(Track(np.zeros(101), 0.1e-3), speed=0.02, model=DynamicStylus())
+    >>> round(forces(result)["F_y_mean"], 6)  # N
+    1.0
+    """
 
     def __init__(self, stiffness=STIFFNESS, mass=STYLUS_MASS, damping=STYLUS_DAMPING, period=1e-3, substeps=10):
         if not (stiffness > 0 and mass > 0 and damping >= 0 and period > 0 and substeps >= 1):

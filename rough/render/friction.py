@@ -1,4 +1,4 @@
-"""Friction between stylus and surface (MATH.md §5.6), off by default.
+"""Friction between stylus and surface (docs/math.rst §5.6), off by default.
 
 Each model gives the friction force along the surface tangent from the horizontal
 motion of the stylus while it touches; out of contact there is none and the model's
@@ -113,7 +113,54 @@ MODELS = {
 
 
 def parse_friction(spec):
-    """A friction model from ``MODEL[:key=value,...]``; ``none`` (or None) gives None."""
+    """A friction model from its command-line spec, ``MODEL[:key=value,...]``.
+
+    Parameters
+    ----------
+    spec : str or None
+        ``coulomb`` (keys ``level``, ``viscous``), ``karnopp`` (``static``,
+        ``coulomb``, ``viscous``, ``band``, ``stiffness``, ``damping``) or ``dahl``
+        (``stiffness``, ``coulomb``); each value a number with a unit (``0.3N``,
+        ``2N*s/m``, ``2mm/s``, ``1N/mm``). Keys left out take the model's defaults.
+        ``none``, ``off``, an empty string or None mean no friction.
+
+    Returns
+    -------
+    CoulombViscous, Karnopp, Dahl or None
+        The model, with every value in SI units (N, N·s/m, m/s, N/m); None for no
+        friction.
+
+    Raises
+    ------
+    rough.InputError
+        For an unknown model or key, a value without a unit or in the wrong unit, a
+        negative value, or values the model refuses (Karnopp needs static ≥ coulomb).
+
+    Notes
+    -----
+    Levels are forces (N) that do not scale with the contact force. The model's
+    ``force(contact, x, velocity, period)`` gives the tangential force on the stylus,
+    positive along +x; zero out of contact.
+
+    Examples
+    --------
+    >>> from rough.render import parse_friction
+    >>> model = parse_friction("coulomb:level=0.3N,viscous=2N*s/m")
+    >>> type(model).__name__, model.level, model.viscous  # N, N·s/m
+    ('CoulombViscous', 0.3, 2.0)
+    >>> model.force(True, 0.0, 0.01, 1e-3)  # sliding at +10 mm/s: -(0.3 + 2 × 0.01) N
+    -0.32
+    >>> parse_friction("karnopp:static=0.8N,coulomb=0.5N,band=2mm/s").band  # m/s
+    0.002
+    >>> parse_friction("none") is None
+    True
+    >>> import rough
+    >>> try:
+    ...     parse_friction("coulomb:level=0.3")
+    ... except rough.InputError as error:
+    ...     print(error)
+    '0.3' is not a force (write a number with one of the units N, mN, kN)
+    """
     from ..units import parse_quantity
 
     if spec is None or spec.strip().lower() in ("", "none", "off"):

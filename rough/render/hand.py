@@ -1,7 +1,7 @@
 """A simulated hand on a simulated joystick: the ``sim`` device.
 
 The hand strokes along x at a constant ``speed`` while pressing down with the force
-``press``, through its own ``mass`` and ``damping`` (MATH.md §5.5's illustration: a
+``press``, through its own ``mass`` and ``damping`` (docs/math.rst §5.5's illustration: a
 0.15 kg hand with 2 N·s/m pushing down with 1 N). Along x it follows its stroke
 rigidly, unless ``lateral_stiffness`` (N/m, with ``lateral_damping``) lets the
 lateral and friction forces push it off its path. The force the loop writes is held
@@ -18,7 +18,66 @@ PRESS = 1.0  # N
 
 
 class SimulatedHand:
-    """The device interface (``read``, ``write``, ``close``) on a model of a hand."""
+    """The device interface (``read``, ``write``, ``close``) on a model of a hand.
+
+    The hand strokes along x at a constant ``speed`` while pressing down with
+    ``press``, through its own ``mass`` and ``damping``; the force written is held
+    for one period and the motion over it integrated exactly. ``read()`` returns
+    ``(x, y, buttons)`` (m, m, always 0), ``write(fx, fy)`` applies a force (N) for
+    one period, ``close()`` releases nothing.
+
+    Parameters
+    ----------
+    speed : float
+        The stroking speed along x, m/s.
+    start_x, start_y : float
+        Where the hand starts, metres.
+    period : float
+        The servo period, s.
+    press : float, default 1.0
+        The downward force of the hand, N.
+    mass : float, default 0.15
+        The hand's mass, kg.
+    damping : float, default 2.0
+        The hand's vertical damping, N·s/m.
+    lateral_stiffness : float, optional
+        N/m: lets the lateral and friction forces push the hand off its stroke along
+        x; default None, a rigid stroke.
+    lateral_damping : float, default 20.0
+        N·s/m, with ``lateral_stiffness``.
+
+    Attributes
+    ----------
+    name : str
+        ``"sim"``.
+    needs_watchdog : bool
+        False: a simulated hand cannot feel a stuck force.
+    ticks : int
+        Periods written so far.
+    y, vy : float
+        The hand's height (m) and vertical velocity (m/s).
+    velocity : tuple of float
+        ``(vx, vy)``, m/s.
+
+    Raises
+    ------
+    ValueError
+        For a mass or period that is not positive, or a negative damping.
+
+    Examples
+    --------
+    Left to its own press of 1 N, the 0.15 kg hand sinks by about F t²/(2m) = 3.3 µm
+    in the first millisecond, while it strokes 20 µm along x:
+
+    >>> from rough.render import SimulatedHand
+    >>> hand = SimulatedHand(0.02, start_x=0.0, start_y=0.0, period=1e-3)
+    >>> hand.read()
+    (0.0, 0.0, 0)
+    >>> hand.write(0.0, 0.0)  # no force from the surface
+    >>> x, y, buttons = hand.read()
+    >>> round(x * 1e6, 6), round(y * 1e6, 2)  # µm
+    (20.0, -3.32)
+    """
 
     name = "sim"
     needs_watchdog = False

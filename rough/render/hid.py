@@ -231,9 +231,57 @@ def _array(report):
 
 
 def find_joystick(spec="hid"):
-    """Open the joystick ``spec`` names (``hid``: the first PID joystick; ``hid:VID:PID``
-    in hex) through hidapi's hidraw backend: ``(handle, descriptor, label)``."""
-    import hidraw
+    """Open a force-feedback joystick through hidapi's hidraw backend.
+
+    The first hidraw device whose report descriptor offers the HID PID (force
+    feedback) reports, or the one with the given vendor and product ID.
+
+    Parameters
+    ----------
+    spec : str, default "hid"
+        ``hid`` for the first PID joystick, or ``hid:VID:PID`` with hexadecimal IDs
+        (e.g. ``hid:1209:0001``).
+
+    Returns
+    -------
+    handle : hidraw.device
+        The open device.
+    descriptor : bytes
+        Its HID report descriptor.
+    label : str
+        The product name and IDs, e.g. ``"Impulse Engine (1209:0001)"``.
+
+    Raises
+    ------
+    rough.RoughError
+        A ``PidError`` (exit status 1) for a malformed ``spec``, when no HID device
+        speaks HID PID, or when a candidate could not be opened (with the hidraw
+        permissions as a hint).
+
+    See Also
+    --------
+    rough.render.run : Run the servo loop on a device.
+
+    Examples
+    --------
+    Opening a joystick needs the hardware (and permission to open its hidraw
+    node), so no example here opens one: with a force-feedback joystick plugged in,
+    ``find_joystick("hid")`` returns ``(handle, descriptor, label)`` and
+    ``find_joystick("hid:1209:0001")`` picks the device with those IDs; without one
+    it raises a ``PidError`` saying that no force-feedback joystick was found. A
+    malformed spec is refused before any device is looked at:
+
+    >>> import rough
+    >>> from rough.render.hid import find_joystick
+    >>> try:
+    ...     find_joystick("hid:zz")
+    ... except rough.RoughError as error:
+    ...     print(error)
+    --device 'hid:zz': write hid or hid:VID:PID with hexadecimal IDs, e.g. hid:1209:0001
+    """
+    from ..extras import require
+
+    hidraw = require("hidraw")
 
     wanted = None
     if spec != "hid":

@@ -44,7 +44,39 @@ class LoopStalled(RoughError):
 
 @dataclasses.dataclass
 class Settings:
-    """What the loop needs besides the device, surfaces and models (SI units)."""
+    """What the loop needs besides the device, surfaces and models (SI units).
+
+    Attributes
+    ----------
+    rate : float, default 1000.0
+        Ticks per second, Hz.
+    duration : float or None, default None
+        How long to run, s; None runs until stopped (Ctrl-C, or ``until``).
+    ramp : float, default 0.0
+        Seconds over which the force ramps in at the start.
+    max_force : float, default 8.9
+        The force limit, N (the Impulse Engine 2000's): the force vector is scaled
+        down to it every tick.
+    realtime : bool, default True
+        Pace the ticks by a deadline clock; False runs a simulated device as fast as
+        the machine allows.
+    velocity_cutoff : float, default 100.0
+        The cut-off of the first-order low-pass on the velocity and acceleration
+        estimates, Hz.
+    watchdog : float, default 0.01
+        Seconds of stalled loop after which the watchdog zeroes a joystick's force.
+    priority : int, default 50
+        The SCHED_FIFO priority asked for in real time (0: normal priority).
+    period : float
+        ``1 / rate``, s.
+
+    Examples
+    --------
+    >>> from rough.render import Settings
+    >>> settings = Settings(rate=2000.0, realtime=False)
+    >>> settings.period, settings.max_force  # s, N
+    (0.0005, 8.9)
+    """
 
     rate: float = 1000.0
     duration: float = None
@@ -57,13 +89,63 @@ class Settings:
 
     @property
     def period(self):
+        """``1 / rate``, s."""
         return 1.0 / self.rate
 
 
 @dataclasses.dataclass
 class Run:
-    """What a run did: the trace (a structured array with TRACE_FIELDS, one row per
-    tick), the tick start times and deadlines (real-time runs), and how it ended."""
+    """What a run did: the trace, the timing, and how it ended.
+
+    Attributes
+    ----------
+    trace : numpy.ndarray
+        A structured array, one row per tick, with the fields of ``TRACE_FIELDS``:
+        ``t`` (s), ``x`` (stylus position, m), ``y_i`` (hand height, m), ``h`` (the
+        surface under the stylus, m; NaN where there is no surface), ``F_x``,
+        ``F_y`` (the force written, N) and ``contact`` (bool).
+    ticks : int
+        Ticks run.
+    wall_time : float
+        Seconds the loop took.
+    settings : Settings
+        The settings it ran with.
+    starts, deadlines : numpy.ndarray or None
+        Real-time runs: each tick's start time and deadline (``time.perf_counter``
+        seconds); None when unpaced.
+    missed : int
+        Deadlines missed (ticks that started a whole period or more late).
+    switches : int
+        How many times the trigger switched between two surfaces.
+    ended_by : str
+        ``"duration"``, ``"answer"`` (``until`` returned an answer) or
+        ``"interrupt"`` (Ctrl-C).
+    speed : float or None
+        The stroking speed of a simulated run, m/s.
+    device : str
+        ``"sim"``, or the joystick's label.
+    scheduling : str
+        ``"unpaced"``, ``"normal priority"`` or ``"SCHED_FIFO N"``.
+    answer : object
+        What ``until`` returned to end the run, or None.
+
+    Notes
+    -----
+    ``timing()`` gives the achieved rate (Hz), the period jitter p50/p99/max (s), the
+    missed deadlines and the largest lateness (s) of a real-time run; for an unpaced
+    run only the ticks, simulated and wall time and their ratio.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from rough.render import Track, simulate
+    >>> result = simulate(Track(np.zeros(101), 0.1e-3), speed=0.02)  # 10 mm at 20 mm/s
+    >>> result.ticks, result.trace.shape, result.device, result.scheduling
+    (500, (500,), 'sim', 'unpaced')
+    >>> timing = result.timing()
+    >>> round(timing["simulated_time"], 9), timing["realtime_factor"] > 1  # s
+    (0.5, True)
+    """
 
     trace: np.ndarray
     ticks: int
@@ -129,11 +211,65 @@ class _Watchdog(threading.Thread):
 
 
 def run(device, tracks, model, friction=None, settings=None, until=None):
-    """Run the loop on ``device`` over ``tracks`` (one or two :class:`Track`; the
-    trigger switches between two) until ``settings.duration`` passes, ``until(buttons)``
-    returns something true (kept as ``Run.answer``) or Ctrl-C. The contact model and
-    friction start afresh. Returns a :class:`Run`; the device is closed (force zero)
-    however the loop ends."""
+    """Run the servo loop: read the device, compute the force, write it, every period.
+
+    Parameters
+    ----------
+    device : object
+        A device with ``read()`` → ``(x m, y m, buttons)``, ``write(fx, fy)`` (N) and
+        ``close()``: a :class:`~rough.render.hand.SimulatedHand` or a joystick.
+    tracks : list of Track
+        One or two tracks; the trigger (button 1) switches between two.
+    model : QuasiStatic or DynamicStylus
+        The contact model; it starts afresh.
+    friction : object, optional
+        A friction model from :func:`parse_friction` (it starts afresh); default none.
+    settings : Settings, optional
+        Default ``Settings()`` (real time, 1 kHz, until stopped).
+    until : callable, optional
+        Called with the buttons every tick; when it returns something true the loop
+        ends and keeps it as ``Run.answer``.
+
+    Returns
+    -------
+    Run
+        The trace and timing. However the loop ends (its duration, ``until``,
+        Ctrl-C, an exception), the device is closed, which zeroes the force.
+
+    Raises
+    ------
+    rough.RoughError
+        ``LoopStalled`` when the watchdog found the loop stalled and zeroed the
+        force (devices that need a watchdog, in real time).
+
+    Notes
+    -----
+    Each tick estimates the velocity and acceleration (backward differences through
+    a first-order low-pass), looks up the surface under the stylus, asks the contact
+    and friction models for the force, clamps the force vector to
+    ``settings.max_force``, ramps it in over ``settings.ramp`` and writes it. A
+    force that is not finite (NaN heights, a diverging model) is written as zero.
+
+    Examples
+    --------
+    The simulated hand on a flat track, for 0.1 s, and then until a callback answers:
+
+    >>> import numpy as np
+    >>> from rough.render import QuasiStatic, Settings, SimulatedHand, Track, run
+    >>> track = Track(np.zeros(101), 0.1e-3)
+    >>> hand = SimulatedHand(0.02, start_x=0.0, start_y=0.0, period=1e-3)
+    >>> result = run(hand, [track], QuasiStatic(), settings=Settings(duration=0.1, realtime=False))
+    >>> result.ticks, result.ended_by
+    (100, 'duration')
+    >>> calls = []
+    >>> def ten_ticks(buttons):
+    ...     calls.append(buttons)
+    ...     return "enough" if len(calls) > 10 else None
+    >>> hand = SimulatedHand(0.02, start_x=0.0, start_y=0.0, period=1e-3)
+    >>> result = run(hand, [track], QuasiStatic(), settings=Settings(realtime=False), until=ten_ticks)
+    >>> result.ticks, result.ended_by, result.answer
+    (10, 'answer', 'enough')
+    """
     settings = settings or Settings()
     model.reset()
     if friction is not None:

@@ -118,10 +118,12 @@ class PidDescriptor:
     """The reports a constant-force joystick offers, from its report descriptor bytes."""
 
     def __init__(self, descriptor):
-        import hidtools.hid
+        from ..extras import require
+
+        descriptors = require("hidtools.hid")
 
         try:
-            parsed = hidtools.hid.ReportDescriptor.from_bytes(list(descriptor))
+            parsed = descriptors.ReportDescriptor.from_bytes(list(descriptor))
         except Exception as error:  # noqa: BLE001 -- hid-tools raises assorted errors on bad descriptors
             raise PidError(f"unreadable HID report descriptor ({type(error).__name__}: {error})") from None
         self.joystick = _find(parsed.input_reports, lambda u, a: X in u and Y in u, "an input report with X and Y axes")

@@ -19,8 +19,58 @@ from ..errors import InputError
 class Track:
     """h(x), h'(x) and h''(x) of a profile along x in [start, end] (metres).
 
-    ``heights`` must be finite (fill gaps first); ``spacing`` in metres. Outside the
-    profile there is no surface: :meth:`at` returns a height of -inf there.
+    Slopes are central differences and curvatures second differences at the nodes
+    (one-sided at the ends), computed once; between nodes all three are
+    interpolated linearly. ``Track.from_surface(surface, row=None)`` takes the
+    profile of a surface, or the map row nearest to ``row`` (metres along y; default
+    the middle row); ``track.at(x)`` gives ``(h, h', h'')`` at ``x``, and
+    ``(-inf, 0, 0)`` off the profile, where there is no surface.
+
+    Parameters
+    ----------
+    heights : array_like of float
+        The profile's heights, metres: at least 3 points, all finite (fill invalid
+        points first).
+    spacing : float
+        The spacing of the heights, metres.
+    start : float, default 0.0
+        The position of the first point, metres.
+
+    Attributes
+    ----------
+    heights, slopes, curvature : numpy.ndarray
+        h (m), h' (m/m) and h'' (1/m) at the nodes.
+    spacing, start, end : float
+        The spacing and the positions of the first and last nodes, metres.
+    length : float
+        ``end - start``, metres.
+    top, bottom : float
+        The highest and lowest heights, metres.
+
+    Raises
+    ------
+    rough.InputError
+        For fewer than 3 points, invalid (NaN or infinite) heights, or a map row
+        outside the map.
+
+    Examples
+    --------
+    A parabola h = x² (in µm, x in mm): slope 2x, curvature 2 µm/mm² = 2 m⁻¹:
+
+    >>> from rough.render import Track
+    >>> track = Track([0, 1e-6, 4e-6, 9e-6, 16e-6], 1e-3)  # x = 0 … 4 mm
+    >>> h, slope, curvature = track.at(2e-3)
+    >>> round(h * 1e6, 9), round(slope, 9), round(curvature, 9)
+    (4.0, 0.004, 2.0)
+    >>> track.at(5e-3)  # past the end: no surface
+    (-inf, 0.0, 0.0)
+
+    From a surface:
+
+    >>> import rough
+    >>> track = Track.from_surface(rough.read(rough.sample("rock-profile.tsv")))
+    >>> f"{track.length * 1e3:.2f} mm", track.heights.size
+    ('63.25 mm', 2048)
     """
 
     def __init__(self, heights, spacing, start=0.0):
@@ -71,4 +121,5 @@ class Track:
 
     @property
     def length(self):
+        """``end - start``, metres."""
         return self.end - self.start
