@@ -9,17 +9,21 @@ BIN = $(VENV)/bin
 DEMO = build/demo
 SOURCES = setup.cfg pyproject.toml LICENSE README.md $(shell find rough sample_profiles -name '*.py' -o -name '*.tsv' -o -name '*.x3p')
 
-.PHONY: demo demo-pipeline test lint format docs wheel bench fuzz clean
+.PHONY: demo demo-pipeline test lint format docs wheel install-wheel bench fuzz clean
 
 $(BIN)/.installed: $(SOURCES)
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
+	flock $(VENV)/.install-lock $(MAKE) --no-print-directory install-wheel
+	touch $@
+
+# one at a time (flock above): parallel runs would share dist/ and build/
+install-wheel:
 	$(BIN)/python -m pip install --quiet --upgrade pip setuptools wheel
 	$(BIN)/python -m pip uninstall --quiet --yes rough 2>/dev/null || true  # the distribution's name up to 0.1.0
 	rm -rf dist build/lib build/bdist.*
 	$(BIN)/python -m pip wheel --quiet --no-deps --no-build-isolation --wheel-dir dist .
 	$(BIN)/python -m pip install --quiet "$$(ls dist/rough_metrology-*.whl)[all,test,lint,docs]"
 	$(BIN)/python -m pip install --quiet --no-deps --force-reinstall dist/rough_metrology-*.whl
-	touch $@
 
 wheel: $(BIN)/.installed
 

@@ -22,11 +22,18 @@ def _pyplot():
 
 
 def save(figure, path):
-    """Write ``figure`` to ``path`` (atomically) and close it."""
+    """Write ``figure`` to ``path`` (atomically; ``-`` is standard output, in PNG) and close it."""
+    import sys
+
+    from .errors import InputError
     from .io.atomic import atomic_output
 
     extension = os.path.splitext(os.fspath(path))[1].lstrip(".").lower() or "png"
     try:
+        if os.fspath(path) == "-" and sys.stdout is not None and sys.stdout.isatty():
+            refusal = InputError("refusing to write a plot to a terminal: give a file name or a pipe")
+            refusal.filename = "-"
+            raise refusal
         with atomic_output(path) as stream:
             figure.savefig(stream, format=extension, dpi=150, bbox_inches="tight")
     finally:

@@ -17,6 +17,7 @@ from . import __version__
 from .errors import InputError
 
 MAX_POINTS = 1 << 28  # 16384 × 16384: with its spectrum, about 6 GiB of working memory
+SPACING_RANGE = (1e-12, 1e6)  # metres: below atomic resolution or beyond a continent, a unit is wrong
 
 
 def check_size(shape, what):
@@ -103,7 +104,7 @@ class Surface:
     ------
     rough.InputError
         For heights that are not numbers, not 1-D or 2-D, or empty, and for a spacing
-        or origin of the wrong length, not finite, or (spacing) not positive.
+        or origin of the wrong length, not finite, or (spacing) outside 1 pm to 1000 km.
 
     See Also
     --------
@@ -167,6 +168,7 @@ class Surface:
             raise InputError("a surface needs at least one point")
         self.heights = heights
         self.spacing = _lengths(self.spacing, heights.ndim, "spacing", positive=True)
+        _check_spacing(self.spacing)
         self.origin = _lengths(self.origin or (0.0,) * heights.ndim, heights.ndim, "origin")
 
     @property
@@ -265,6 +267,16 @@ def _lengths(values, ndim, name, positive=False):
     if not all(np.isfinite(values)) or (positive and min(values) <= 0):
         raise InputError(f"{name} must be finite{' and positive' if positive else ''}, got {values}")
     return values
+
+
+def _check_spacing(spacing):
+    low, high = SPACING_RANGE
+    outside = [d for d in spacing if not low <= d <= high]
+    if outside:
+        raise InputError(
+            f"a spacing of {outside[0]:g} m is outside what any instrument samples at "
+            f"({low:g} m to {high:g} m); check the file's units or --spacing"
+        )
 
 
 def _index_range(bound, origin, spacing, count, name):

@@ -62,21 +62,20 @@ def detrend(surface, input, order, cutoff, keep, ends, tip, envelope, output):
         rough detrend --tip fingernail rock.x3p | rough features
         rough detrend --envelope 2um stylus-scan.x3p -o material.x3p
     """
-    from ..errors import InputError
     from ..metrology import detrend as remove
     from ..metrology import split
     from ..metrology.tip import closing_envelope, traced
 
     if tip is not None and envelope is not None:
-        raise InputError("give --tip or --envelope, not both")
+        raise click.UsageError("give --tip or --envelope, not both")
     probe = tip if tip is not None else envelope
     if probe is None:
         output.write(remove(surface, order=2 if order is None else order, cutoff=cutoff, keep=keep, ends=ends))
         return
     if keep == "form":
-        raise InputError("--keep form needs a polynomial, not --tip/--envelope")
+        raise click.UsageError("--keep form needs a polynomial, not --tip/--envelope")
     if keep == "waviness" and cutoff is None:
-        raise InputError("the waviness needs a cut-off (--cutoff)")
+        raise click.UsageError("the waviness needs a cut-off (--cutoff)")
     if order is not None:
         surface = remove(surface, order=order)
     surface = traced(surface, probe) if tip is not None else closing_envelope(surface, probe)

@@ -169,10 +169,12 @@ def run(study, subject, haptics, observer, speed, stroke, realtime):
     --device sim, --observer answers.
     """
     from ..errors import InputError
-    from ..experiment.design import load_study
+    from ..experiment.design import is_name, load_study
     from ..experiment.observer import parse_observer
     from ..experiment.session import run_session, simulated_presenter
 
+    if not is_name(subject):
+        raise InputError(f"--subject {subject!r}: not a name (letters, digits, - and _ only)")
     loaded = load_study(study)
     loaded.trials_of(subject)
     contact, friction = haptics.contact(), haptics.friction_model()

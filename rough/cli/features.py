@@ -4,7 +4,7 @@ slides' feature detection and Rq against evaluation length."""
 import click
 
 from .options import LENGTH, crop_option, plot_option, report_format, surface_input
-from .report import emit
+from .report import emit, on_stdout
 
 
 @click.command(short_help="ISO parameters (Ra…JRC, Sa…Std), amplitude density, feature detection.")
@@ -65,11 +65,18 @@ from .report import emit
     show_default=True,
     help="Feature detection: which features to find.",
 )
-@click.option("--list", "feature_list", metavar="FILE", help="Write one TSV row per detected feature (SI units).")
+@click.option(
+    "--list",
+    "feature_list",
+    metavar="FILE",
+    help="Write one TSV row per detected feature (SI units); - is standard output, instead of the report.",
+)
 @click.option(
     "--vs-length", is_flag=True, help="Also report Rq against evaluation length and the slope of log Rq on log L."
 )
-@plot_option("Draw the profile (features shaded) or map, and the amplitude density.")
+@plot_option(
+    "Draw the profile (features shaded) or map, and the amplitude density; - is standard output, instead of the report."
+)
 @report_format
 def features(
     surface,
@@ -108,6 +115,7 @@ def features(
     from .. import metrology
     from ..io.atomic import atomic_output
 
+    report = not on_stdout(list=feature_list, plot=plot)
     evaluated = surface if cutoff is None else metrology.split(surface, cutoff, "roughness", ends)
     values = metrology.parameters(
         evaluated, sampling_lengths=sampling_lengths, slope=slope, along=along, jrc_spacing=jrc_spacing
@@ -144,7 +152,8 @@ def features(
         from .. import plots
 
         plots.save(plots.features_figure(evaluated, found, (centres, density)), plot)
-    emit(rows, document, as_json, as_tsv)
+    if report:
+        emit(rows, document, as_json, as_tsv)
 
 
 def _parameter_rows(surface, values, table, cutoff, sampling_lengths, slope, jrc_spacing, along):

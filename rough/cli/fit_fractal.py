@@ -3,7 +3,7 @@
 import click
 
 from .options import BAND, LENGTH, crop_option, plot_option, report_format, surface_input
-from .report import emit
+from .report import emit, on_stdout
 
 
 @click.command("fit-fractal", short_help="Fractal dimension D and amplitude coefficient C, with uncertainty.")
@@ -33,9 +33,13 @@ from .report import emit
 )
 @click.option("--fill", is_flag=True, help="Fill invalid points first (linear along profiles, biharmonic in maps).")
 @click.option(
-    "--psd", "psd_file", metavar="FILE", help="Write the log-binned spectrum as TSV (frequency 1/m, density, count)."
+    "--psd",
+    "psd_file",
+    metavar="FILE",
+    help="Write the log-binned spectrum as TSV (frequency 1/m, density, count); - is standard output, "
+    "instead of the report.",
 )
-@plot_option("Draw the spectrum on log-log axes with the fitted power law.")
+@plot_option("Draw the spectrum with the fitted power law on log-log axes; - is standard output, not the report.")
 @report_format
 def fit_fractal(surface, input, band, resolution, method, order, sampling, fill, psd_file, plot, as_json, as_tsv):
     """Fit the power law of INPUT's power spectrum (default: standard input): the
@@ -60,6 +64,7 @@ def fit_fractal(surface, input, band, resolution, method, order, sampling, fill,
     from ..fractal.resample import fill_invalid
     from ..io.atomic import atomic_output
 
+    report = not on_stdout(psd=psd_file, plot=plot)
     if fill:
         surface = fill_invalid(surface)
     result = fit(surface, band=band, resolution=resolution, method=method, order=order, sampling=sampling)
@@ -93,7 +98,8 @@ def fit_fractal(surface, input, band, resolution, method, order, sampling, fill,
             ),
             plot,
         )
-    emit(_rows(result, surface, document), document, as_json, as_tsv)
+    if report:
+        emit(_rows(result, surface, document), document, as_json, as_tsv)
 
 
 def _rows(result, surface, document):

@@ -8,17 +8,38 @@ import click
 
 from .options import SPACING, QuantityType
 
+MAX_RATE = 100e3  # Hz: a Python tick takes a few microseconds; no device or model needs more
+
+
+class PositiveQuantity(QuantityType):
+    """A quantity that must be positive (and at most ``most``, if given)."""
+
+    def __init__(self, kind, default_unit, most=None):
+        super().__init__(kind, default_unit)
+        self.most = most
+
+    def convert(self, value, param, ctx):
+        quantity = super().convert(value, param, ctx)
+        if quantity <= 0:
+            self.fail(f"{value!r}: must be positive", param, ctx)
+        if self.most is not None and quantity > self.most:
+            self.fail(f"{value!r}: at most {self.most:g} {self.default_unit}", param, ctx)
+        return quantity
+
+
 FORCE, STIFFNESS, DAMPING = (
     QuantityType("force", "N"),
-    QuantityType("stiffness", "N/mm"),
+    PositiveQuantity("stiffness", "N/mm"),
     QuantityType("damping", "N*s/m"),
 )
 MASS, SPEED, TIME, RATE = (
-    QuantityType("mass", "g"),
-    QuantityType("speed", "mm/s"),
-    QuantityType("time", "s"),
-    QuantityType("rate", "Hz"),
+    PositiveQuantity("mass", "g"),
+    PositiveQuantity("speed", "mm/s"),
+    PositiveQuantity("time", "s"),
+    PositiveQuantity("rate", "Hz", most=MAX_RATE),
 )
+MAX_FORCE = PositiveQuantity("force", "N")
+RAMP = QuantityType("time", "s")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -122,7 +143,7 @@ def haptic_options(command):
         ),
         click.option(
             "--max-force",
-            type=FORCE,
+            type=MAX_FORCE,
             default="8.9N",
             show_default=True,
             help="Device maximum; the force vector is scaled to it.",
@@ -138,7 +159,7 @@ def haptic_options(command):
             "--invert", type=click.Choice(["x", "y"]), multiple=True, help="hid: reverse an axis (position and force)."
         ),
         click.option(
-            "--ramp", type=TIME, help="Ramp the force in over this time at the start (default: hid 0.5 s, sim none)."
+            "--ramp", type=RAMP, help="Ramp the force in over this time at the start (default: hid 0.5 s, sim none)."
         ),
         click.option(
             "--velocity-filter",

@@ -3,13 +3,17 @@
 Subcommand modules are imported only when needed, and they import the library only
 inside their functions, so ``rough --help`` starts without numpy. Errors end in one
 line on stderr (``rough COMMAND: FILE: problem``) and an exit status: 0 success, 2 bad
-usage or bad input, 1 any other failure, 130 interrupted; a closed downstream pipe
-ends the command quietly (141, as a SIGPIPE death would).
+usage or bad input, 1 any other failure, 130 interrupted (Ctrl-C), 143 terminated
+(SIGTERM), 129 hung up (SIGHUP); a closed downstream pipe ends the command quietly
+(141, as a SIGPIPE death would).
 """
 
+import contextlib
+import errno
 import importlib
 import logging
 import os
+import signal
 import sys
 import warnings
 
@@ -31,6 +35,8 @@ COMMANDS = {
 }
 
 log = logging.getLogger("rough")
+# OSErrors that say a name given on the command line is unusable: bad input, status 2
+_BAD_NAME = {errno.ENAMETOOLONG, errno.ELOOP, errno.ENOTDIR, errno.EISDIR, errno.ENOENT, errno.ENXIO}
 _invoked = []
 
 
@@ -42,6 +48,19 @@ class PipeClosed(Exception):
 class Interrupted(Exception):
     """Ctrl-C during a command (raised instead of KeyboardInterrupt, which click answers
     with a blank line on standard error)."""
+
+
+class Stopped(BaseException):
+    """SIGTERM or SIGHUP, raised in the main thread so that temporary files are cleaned
+    up on the way out, as after Ctrl-C (a BaseException: no ``except Exception`` stops it)."""
+
+    def __init__(self, signum):
+        super().__init__(signum)
+        self.signum = signum
+
+
+def _stop(signum, frame):
+    raise Stopped(signum)
 
 
 class LazyGroup(click.Group):
@@ -86,7 +105,7 @@ def cli(quiet, verbose, debug):
     Invalid points are NaN throughout.
     """
     level = logging.ERROR if quiet else (logging.WARNING, logging.INFO, logging.DEBUG)[min(verbose, 2)]
-    handler = logging.StreamHandler(sys.stderr)
+    handler = logging.StreamHandler(sys.stderr) if sys.stderr else logging.NullHandler()
     handler.setFormatter(_Formatter())
     log.handlers[:] = [handler]
     log.setLevel(level)
@@ -100,8 +119,10 @@ def _warn_in_one_line(message, category, filename, lineno, file=None, line=None)
 
 class _Formatter(logging.Formatter):
     def format(self, record):
+        from .report import printable
+
         kind = "warning: " if record.levelno >= logging.WARNING else ""
-        return f"{_prefix()}: {kind}{record.getMessage()}"
+        return printable(f"{_prefix()}: {kind}{record.getMessage()}")
 
 
 def _prefix():
@@ -115,18 +136,36 @@ def main(args=None):
 
 
 def run(args):
-    """Run the command line with ``args``; return the exit status."""
+    """Run the command line with ``args``; return the exit status. SIGTERM and SIGHUP
+    end it as Ctrl-C does, cleaning up (status 143 and 129)."""
+    _open_standard_descriptors()
+    previous = {}
+    for signum in {signal.SIGTERM, getattr(signal, "SIGHUP", signal.SIGTERM)}:
+        with contextlib.suppress(ValueError):  # not the main thread: leave the signals alone
+            if signal.getsignal(signum) == signal.SIG_DFL:  # nohup's SIG_IGN stays
+                previous[signum] = signal.signal(signum, _stop)
+    try:
+        return _run(args)
+    finally:
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
+
+
+def _run(args):
     from ..errors import RoughError
 
     debug = "--debug" in args
-    # numpy's RuntimeWarnings (invalid value, overflow) are noise on a command line: rough
-    # announces the NaN and infinities it produces itself
-    warnings.filterwarnings("ignore", category=RuntimeWarning, module=r"numpy(\.|$)")
-    warnings.filterwarnings("ignore", r"(invalid value|divide by zero|overflow) encountered", RuntimeWarning)
+    # numpy's RuntimeWarnings (invalid value, overflow, mean of empty slice) are noise on a
+    # command line: rough announces the NaN and infinities it produces itself
+    warnings.filterwarnings("ignore", category=RuntimeWarning)
     warnings.showwarning = _warn_in_one_line
     try:
         result = cli.main(args=args, prog_name="rough", standalone_mode=False)
+        _flush_stdout()
         return result if isinstance(result, int) else 0
+    except Stopped as stopped:
+        _say("hung up" if stopped.signum == getattr(signal, "SIGHUP", None) else "terminated")
+        return 128 + stopped.signum
     except click.exceptions.Exit as done:
         return done.exit_code
     except click.UsageError as error:
@@ -153,7 +192,7 @@ def run(args):
     except OSError as error:
         where = f"{error.filename}: " if error.filename else ""
         _report(error, debug, f"{where}{error.strerror or error}")
-        return 1
+        return 2 if error.filename and error.errno in _BAD_NAME else 1
     except Exception as error:  # noqa: BLE001 -- the last resort: say what failed, in one line
         _report(error, debug, f"internal error: {type(error).__name__}: {error} (run with --debug for details)")
         return 1
@@ -168,10 +207,39 @@ def _report(error, debug, message=None):
 
 
 def _say(message):
+    from .report import printable
+
+    if sys.stderr is None:  # closed: the message is lost, but never sent to standard output
+        return
     try:
-        print(f"{_prefix()}: {message}", file=sys.stderr, flush=True)
+        print(printable(f"{_prefix()}: {message}"), file=sys.stderr, flush=True)
     except (OSError, ValueError):
         pass
+
+
+def _open_standard_descriptors():
+    """Point closed descriptors 0-2 at /dev/null, so that no file rough opens takes their
+    number and receives what a library writes there (sys.stdin/stdout/stderr stay None)."""
+    for fd in (0, 1, 2):
+        try:
+            os.fstat(fd)
+        except OSError:
+            with contextlib.suppress(OSError):
+                opened = os.open(os.devnull, os.O_RDWR)
+                if opened != fd:
+                    os.dup2(opened, fd)
+                    os.close(opened)
+
+
+def _flush_stdout():
+    """A failure to write the last of the output is the command's failure."""
+    try:
+        if sys.stdout is not None:
+            sys.stdout.flush()
+    except BrokenPipeError:
+        raise
+    except OSError as error:
+        raise OSError(error.errno, error.strerror, "standard output") from error
 
 
 def _silence_stdout():

@@ -176,15 +176,24 @@ def input_options(spacing_flag="--spacing", most=1):
     def decorate(command):
         @functools.wraps(command)
         def wrapper(*args, input, spacing, unit, ignore_checksums, **kwargs):
+            from ..errors import InputError
             from ..io import read
 
             names = (input or ("-",)) if most > 1 else (input,)
             if len(names) > most:
                 raise click.UsageError(f"give at most {most} inputs, not {len(names)}")
+            if "-" in names and sys.stdin is None:
+                raise InputError("<stdin>: standard input is closed")
             surfaces = [read(name, spacing=spacing, unit=unit, verify=not ignore_checksums) for name in names]
-            if most > 1:
-                return command(*args, surfaces=surfaces, inputs=list(names), **kwargs)
-            return command(*args, surface=surfaces[0], input=input, **kwargs)
+            try:
+                if most > 1:
+                    return command(*args, surfaces=surfaces, inputs=list(names), **kwargs)
+                return command(*args, surface=surfaces[0], input=input, **kwargs)
+            except InputError as error:
+                shown = "<stdin>" if names[0] == "-" else names[0]
+                if len(names) > 1 or hasattr(error, "filename") or str(error).startswith(f"{shown}: "):
+                    raise
+                raise type(error)(f"{shown}: {error}") from error
 
         argument = (
             click.argument("input", nargs=-1, metavar=f"[INPUT]{' [INPUT]' * (most - 1)}")
@@ -251,30 +260,33 @@ class Output:
 
     @property
     def format(self):
+        from ..errors import InputError
         from ..io import format_for_path
 
         if self.requested_format:
             return self.requested_format
-        return "x3p" if self.path == "-" else format_for_path(self.path)
+        try:
+            return "x3p" if self.path == "-" else format_for_path(self.path)
+        except InputError as error:
+            error.filename = self.path  # names the output: no input name in front
+            raise
 
     def write(self, surface):
         from ..errors import InputError
         from ..io import BINARY, write
+        from ..io.atomic import atomic_output, standard_output
 
+        if self.path == "-" and self.format in BINARY and standard_output() and sys.stdout.isatty():
+            error = InputError(
+                f"refusing to write binary {self.format.upper()} to a terminal: use -o FILE, a pipe, or -f tsv"
+            )
+            error.filename = "-"
+            raise error
         if self.path != "-":
             write(surface, self.path, format=self.format)
             return
-        if self.format in BINARY and sys.stdout.isatty():
-            raise InputError(
-                f"refusing to write binary {self.format.upper()} to a terminal: use -o FILE, a pipe, or -f tsv"
-            )
-        try:
-            write(surface, sys.stdout.buffer, format=self.format)
-            sys.stdout.buffer.flush()
-        except BrokenPipeError:
-            raise
-        except OSError as error:
-            raise OSError(error.errno, error.strerror, "standard output") from error
+        with atomic_output("-") as stream:
+            write(surface, stream, format=self.format)
 
 
 def report_format(command):

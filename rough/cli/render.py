@@ -4,7 +4,7 @@ import click
 
 from .haptics import DAMPING, FORCE, MASS, SPEED, STIFFNESS, TIME, haptic_options
 from .options import CROP, LENGTH, TIP, input_options, plot_option, report_format
-from .report import emit
+from .report import emit, on_stdout
 
 
 @click.command(short_help="The haptic contact loop on a USB force-feedback joystick or a simulated hand.")
@@ -84,14 +84,14 @@ def render(
         rough render --device hid --stick-span 80mm,10mm rough.x3p smooth.x3p
         rough render --tip fingertip --speed 60mm/s fossil.x3p
     """
-    from ..errors import InputError
     from ..render import Track
     from ..render.session import run_hid, run_sim, summary_rows
 
+    report = not on_stdout(trace=trace, plot=plot)
+    if trace == "-" and len(speeds) > 1:
+        raise click.BadParameter("with several speeds, the traces need file names with {speed}", param_hint="--trace")
     if trace and len(speeds) > 1 and "{speed}" not in trace:
         raise click.BadParameter("with several speeds, put {speed} in the trace file name", param_hint="--trace")
-    if duration is not None and duration <= 0:
-        raise InputError("--duration must be positive")
     tracks = []
     for surface in surfaces:
         if window is not None:
@@ -123,7 +123,8 @@ def render(
         runs = [run_hid(haptics.device, tracks, contact, friction, settings, haptics.stick_span, haptics.invert)]
     _outputs(runs, trace, plot)
     rows, document = summary_rows(runs, haptics.model, contact, haptics.friction)
-    emit(rows, document, as_json, as_tsv)
+    if report:
+        emit(rows, document, as_json, as_tsv)
 
 
 def _outputs(runs, trace, plot):

@@ -3,7 +3,7 @@
 import click
 
 from .options import BAND, LENGTH, crop_option, plot_option, report_format, surface_input
-from .report import emit
+from .report import echo, emit, on_stdout
 
 
 @click.command(short_help="D(θ) and C(θ) by direction for maps (the amplitude coefficient rose); Str, Std.")
@@ -28,7 +28,7 @@ from .report import emit
 )
 @click.option("--sampling", type=click.Choice(["point", "band-limited"]), help="As for fit-fractal.")
 @click.option("--fill", is_flag=True, help="Fill invalid points first (biharmonic inpainting).")
-@plot_option("Draw polar roses of C(θ) and D(θ), mirrored to 360°.")
+@plot_option("Draw polar roses of C(θ) and D(θ), mirrored to 360°; - is standard output, instead of the report.")
 @report_format
 def rose(surface, input, step, width, band, resolution, order, sampling, fill, plot, as_json, as_tsv):
     """Fit the surface dimension Ds(θ) and amplitude coefficient C(θ) of the map
@@ -58,6 +58,8 @@ def rose(surface, input, step, width, band, resolution, order, sampling, fill, p
         from .. import plots
 
         plots.save(plots.rose_figure(result, surface.metadata.get("title", "direction dependence")), plot)
+    if on_stdout(plot=plot):
+        return
     if as_tsv:
         _print_tsv(result)
         return
@@ -65,7 +67,7 @@ def rose(surface, input, step, width, band, resolution, order, sampling, fill, p
 
 
 def _print_tsv(result):
-    click.echo(
+    echo(
         "angle_deg\tfractal_dimension\tfractal_dimension_stderr\tamplitude_coefficient_m\tamplitude_coefficient_stderr_m"
     )
     for row in zip(
@@ -75,7 +77,7 @@ def _print_tsv(result):
         result.amplitude_coefficient,
         result.amplitude_coefficient_stderr,
     ):
-        click.echo("\t".join(repr(float(value)) for value in row))
+        echo("\t".join(repr(float(value)) for value in row))
 
 
 def _rows(result):

@@ -153,10 +153,11 @@ def answers_table(study, set_id=None):
             f"{study.folder}: no answers yet{'' if set_id is None else f' for set {set_id}'} (run "
             f"sessions with rough experiment run)"
         )
+    surfaces = study.surfaces
     return {
         "rougher": np.array([int(r["test_rougher"]) for r in rows], dtype=float),
-        "dimension": np.array([float(r["test_dimension"]) - float(r["reference_dimension"]) for r in rows]),
-        "rq": np.array([(float(r["test_rq_m"]) - float(r["reference_rq_m"])) * 1e3 for r in rows]),
+        "dimension": np.array([surfaces[r["test"]]["dimension"] - surfaces[r["reference"]]["dimension"] for r in rows]),
+        "rq": np.array([(surfaces[r["test"]]["rq"] - surfaces[r["reference"]]["rq"]) * 1e3 for r in rows]),
         "subject": [r["subject"] for r in rows],
         "set": [int(r["set"]) for r in rows],
     }
@@ -273,13 +274,18 @@ def _logit(response, columns):
     sm = require("statsmodels.api")
 
     design = np.column_stack(list(columns.values()))
+    if not (np.isfinite(design).all() and np.isfinite(response).all()):
+        raise InputError("the answers hold values that are not finite numbers")
     if np.linalg.matrix_rank(design) < design.shape[1]:
         raise InputError(
             "the design is degenerate: a predictor is a combination of others (too few trials or subjects)"
         )
     with warnings.catch_warnings(), np.errstate(over="ignore", divide="ignore", invalid="ignore"):
         warnings.simplefilter("ignore")
-        return sm.Logit(response, design).fit(disp=0, method="newton", maxiter=100)
+        try:
+            return sm.Logit(response, design).fit(disp=0, method="newton", maxiter=100)
+        except np.linalg.LinAlgError as error:
+            raise InputError(f"the logistic fit failed on these answers ({error})") from None
 
 
 def percentages(study, set_id):

@@ -24,6 +24,7 @@ import json
 import math
 import os
 import pathlib
+import re
 import shutil
 import tempfile
 
@@ -108,6 +109,8 @@ class Study:
         return [t for t in self.trials if t["subject"] == subject]
 
     def answers_path(self, subject):
+        if not is_name(subject):
+            raise InputError(f"{self.folder}: subject {subject!r} is not a name (letters, digits, - and _)")
         return self.folder / "answers" / f"{subject}.csv"
 
 
@@ -196,7 +199,7 @@ def subject_ids(subjects):
             raise InputError("give between 1 and 999 subjects")
         return [f"S{k:0{max(2, len(str(count)))}d}" for k in range(1, count + 1)]
     names = [name.strip() for name in str(subjects).split(",") if name.strip()]
-    if len(set(names)) != len(names) or not all(_safe_name(n) for n in names):
+    if len(set(names)) != len(names) or not all(is_name(n) for n in names):
         raise InputError("subject names must be distinct and use letters, digits, - and _ only")
     return names
 
@@ -371,30 +374,79 @@ def load_study(folder):
     if not path.is_file():
         raise InputError(f"{folder}: not a study folder (no study.json; make one with rough experiment design)")
     try:
-        document = json.loads(path.read_text())
+        document = json.loads(path.read_text(), parse_constant=_refuse_constant)
     except (UnicodeError, json.JSONDecodeError) as error:
         raise InputError(f"{path}: not valid JSON ({error})") from None
+    except ValueError as error:
+        raise InputError(f"{path}: {error}") from None
     if not isinstance(document, dict) or document.get("format") != FORMAT:
         raise InputError(f"{path}: not a {FORMAT} file")
     try:
-        surfaces, sets, subjects, seed = (
-            document["surfaces"],
-            document["sets"],
-            document["subjects"],
-            int(document["seed"]),
-        )
-        for surface in surfaces.values():
-            float(surface["dimension"]), float(surface["rq"]), str(surface["file"])
-        for entry in sets:
-            if entry["reference"] not in surfaces or not all(n in surfaces for n in entry["neighbours"]):
-                raise KeyError("a set names an unknown surface")
+        surfaces, sets, subjects, seed = _check_design(document)
     except (KeyError, TypeError, ValueError, AttributeError) as error:
         raise InputError(f"{path}: incomplete or malformed design ({error})") from None
     for name, surface in surfaces.items():
         if not (folder / surface["file"]).is_file():
             raise InputError(f"{folder}: surface {name} is missing ({surface['file']})")
-    trials = _read_trials(folder / "trials.csv", surfaces, subjects)
+    trials = _read_trials(folder / "trials.csv", surfaces, sets, subjects)
     return Study(folder, surfaces, sets, list(subjects), trials, seed, document.get("preset"))
+
+
+def _refuse_constant(name):
+    raise ValueError(f"{name} is not a number a design can hold")
+
+
+def _check_design(document):
+    surfaces, sets, subjects = document["surfaces"], document["sets"], document["subjects"]
+    seed = document["seed"]
+    if not isinstance(seed, int) or seed < 0:
+        raise ValueError(f"seed {seed!r} is not a whole number")
+    if not isinstance(subjects, list) or not subjects or len(set(map(str, subjects))) != len(subjects):
+        raise ValueError("subjects must be a list of distinct names")
+    for subject in subjects:
+        if not is_name(subject):
+            raise ValueError(f"subject {subject!r} is not a name (letters, digits, - and _)")
+    for name, surface in surfaces.items():
+        dimension, rq, file = surface["dimension"], surface["rq"], surface["file"]
+        if not (_number(dimension) and _number(rq) and rq > 0):
+            raise ValueError(f"surface {name}: D and Rq must be finite numbers, Rq positive")
+        parts = pathlib.PurePosixPath(file).parts if isinstance(file, str) else ()
+        if not parts or file.startswith("/") or "\\" in file or ".." in parts:
+            raise ValueError(f"surface {name}: file {file!r} is not a path inside the study folder")
+    ids = [entry["id"] for entry in sets]
+    if not sets or len(set(ids)) != len(ids) or not all(isinstance(i, int) and not isinstance(i, bool) for i in ids):
+        raise ValueError("sets need distinct whole-number ids")
+    for entry in sets:
+        if entry["reference"] not in surfaces or not all(n in surfaces for n in entry["neighbours"]):
+            raise ValueError(f"set {entry['id']} names an unknown surface")
+    return surfaces, sets, subjects, seed
+
+
+def _number(value):
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
+def read_rows(path, fields, what):
+    """The rows of the CSV file ``path`` with exactly the columns ``fields``, as
+    ``(line, dict)``; an InputError naming the file (and line) otherwise."""
+    if not path.is_file():
+        raise InputError(f"{path}: {what} is missing or not a regular file")
+    try:
+        rows = list(csv.reader(io.StringIO(path.read_text(encoding="utf-8"), newline="")))
+    except (UnicodeError, csv.Error) as error:
+        raise InputError(f"{path}: not a readable {what} ({error})") from None
+    except OSError as error:
+        raise InputError(f"{path}: cannot read the {what} ({error.strerror})") from None
+    if not rows or tuple(rows[0]) != tuple(fields):
+        raise InputError(f"{path}: expected the columns {', '.join(fields)}")
+    result = []
+    for line, row in enumerate(rows[1:], start=2):
+        if not row:
+            continue
+        if len(row) != len(fields):
+            raise InputError(f"{path}, line {line}: {len(row)} fields, expected {len(fields)} (a cut or damaged row)")
+        result.append((line, dict(zip(fields, row))))
+    return result
 
 
 def _write_trials(path, trials):
@@ -404,24 +456,30 @@ def _write_trials(path, trials):
         writer.writerows(trials)
 
 
-def _read_trials(path, surfaces, subjects):
-    if not path.is_file():
-        raise InputError(f"{path.parent}: the trial list trials.csv is missing")
-    rows = list(csv.DictReader(io.StringIO(path.read_text())))
-    if not rows or set(rows[0]) != set(TRIAL_FIELDS):
-        raise InputError(f"{path}: expected the columns {', '.join(TRIAL_FIELDS)}")
-    trials = []
-    for line, row in enumerate(rows, start=2):
+def _read_trials(path, surfaces, sets, subjects):
+    by_id = {entry["id"]: entry for entry in sets}
+    trials, seen = [], set()
+    for line, row in read_rows(path, TRIAL_FIELDS, "trial list trials.csv"):
         try:
             trial = {**row, "trial": int(row["trial"]), "set": int(row["set"])}
         except ValueError:
             raise InputError(f"{path}, line {line}: trial and set must be whole numbers") from None
-        names = {trial["reference"], trial["test"]}
-        if not names <= set(surfaces) or {trial["first"], trial["second"]} != names or trial["subject"] not in subjects:
-            raise InputError(f"{path}, line {line}: unknown surface or subject, or first/second not the pair")
+        entry = by_id.get(trial["set"])
+        if (
+            trial["subject"] not in subjects
+            or entry is None
+            or trial["reference"] != entry["reference"]
+            or trial["test"] not in entry["neighbours"]
+            or sorted((trial["first"], trial["second"])) != sorted((trial["test"], trial["reference"]))
+        ):
+            raise InputError(f"{path}, line {line}: unknown surface, set or subject, or first/second not the pair")
+        if trial["trial"] < 1 or (trial["subject"], trial["trial"]) in seen:
+            raise InputError(f"{path}, line {line}: trial {trial['trial']} of {trial['subject']} is not a new number")
+        seen.add((trial["subject"], trial["trial"]))
         trials.append(trial)
     return trials
 
 
-def _safe_name(name):
-    return all(c.isalnum() or c in "-_" for c in name)
+def is_name(name):
+    """Letters, digits, ``-`` and ``_``: a subject name that is safe as a file name."""
+    return isinstance(name, str) and re.fullmatch(r"[A-Za-z0-9_-]+", name) is not None

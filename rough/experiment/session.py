@@ -16,13 +16,13 @@ import csv
 import dataclasses
 import datetime
 import io
-import pathlib
+import math
 import sys
 import threading
 import time
 
 from ..errors import InputError
-from .design import TRIAL_FIELDS
+from .design import TRIAL_FIELDS, read_rows
 
 ANSWER_FIELDS = TRIAL_FIELDS + (
     "answer",
@@ -38,6 +38,7 @@ ANSWER_FIELDS = TRIAL_FIELDS + (
 )
 ANSWER_BUTTONS = {2: "first", 4: "second"}  # button 2, button 3 (bit masks)
 ANSWER_KEYS = {"1": "first", "2": "second"}
+TIME_FORMAT = "%Y-%m-%dT%H:%M:%SZ"
 
 
 @dataclasses.dataclass
@@ -51,32 +52,58 @@ class Progress:
 
 
 def read_answers(study, subject):
-    """The answered trials of ``subject`` (rows as dicts), checked against the design."""
+    """The answered trials of ``subject`` (rows as dicts), every column checked against
+    the trial list and the design."""
     path = study.answers_path(subject)
-    if not path.exists():
+    if not path.exists() and not path.is_symlink():
         return []
-    try:
-        rows = list(csv.DictReader(io.StringIO(path.read_text())))
-    except (UnicodeError, csv.Error) as error:
-        raise InputError(f"{path}: not a readable answers file ({error})") from None
-    if rows and tuple(rows[0]) != ANSWER_FIELDS:
-        raise InputError(f"{path}: expected the columns {', '.join(ANSWER_FIELDS)}")
     planned = {t["trial"]: t for t in study.trials_of(subject)}
-    seen = set()
-    for line, row in enumerate(rows, start=2):
+    rows, seen = [], set()
+    for line, row in read_rows(path, ANSWER_FIELDS, "answers file"):
+        where = f"{path}, line {line}"
         try:
-            number, rougher = int(row["trial"]), int(row["test_rougher"])
+            number, rougher, toggles = int(row["trial"]), int(row["test_rougher"]), int(row["toggles"])
         except ValueError:
-            raise InputError(f"{path}, line {line}: trial and test_rougher must be whole numbers") from None
+            raise InputError(f"{where}: trial, test_rougher and toggles must be whole numbers") from None
         trial = planned.get(number)
         if trial is None or number in seen or rougher not in (0, 1) or row["answer"] not in ("first", "second"):
-            raise InputError(f"{path}, line {line}: not an answer to a planned trial (or answered twice)")
+            raise InputError(f"{where}: not an answer to a planned trial (or answered twice)")
         if any(str(trial[key]) != row[key] for key in TRIAL_FIELDS):
-            raise InputError(f"{path}, line {line}: does not match trial {number} of trials.csv")
+            raise InputError(f"{where}: does not match trial {number} of trials.csv")
         if (row["answer"] == ("first" if trial["first"] == trial["test"] else "second")) != bool(rougher):
-            raise InputError(f"{path}, line {line}: answer and test_rougher disagree")
+            raise InputError(f"{where}: answer and test_rougher disagree")
+        for column, value in _design_values(study, trial).items():
+            if _float(row[column]) != value:
+                raise InputError(f"{where}: {column} {row[column]!r} is not the design's {value!r}")
+        seconds = _float(row["response_time_s"])
+        if not (seconds >= 0 and toggles >= 0):
+            raise InputError(f"{where}: response_time_s and toggles must be finite and not negative")
+        try:
+            datetime.datetime.strptime(row["finished"], TIME_FORMAT)
+        except ValueError:
+            raise InputError(f"{where}: finished {row['finished']!r} is not a time like 2024-05-01T12:00:00Z") from None
         seen.add(number)
+        rows.append(row)
     return rows
+
+
+def _design_values(study, trial):
+    test, reference = study.surfaces[trial["test"]], study.surfaces[trial["reference"]]
+    return {
+        "reference_dimension": reference["dimension"],
+        "reference_rq_m": reference["rq"],
+        "test_dimension": test["dimension"],
+        "test_rq_m": test["rq"],
+    }
+
+
+def _float(text):
+    """A finite number, or NaN (which equals nothing and passes no comparison)."""
+    try:
+        value = float(text)
+    except ValueError:
+        return math.nan
+    return value if math.isfinite(value) else math.nan
 
 
 def run_session(study, subject, present, device_name):
@@ -136,45 +163,61 @@ def run_session(study, subject, present, device_name):
     9
     >>> folder.cleanup()
     """
-    answers = read_answers(study, subject)
-    done = {int(row["trial"]) for row in answers}
     trials = study.trials_of(subject)
-    for trial in trials:
-        if trial["trial"] in done:
-            continue
-        try:
+    _answers_file(study, subject)
+    saved = 0
+    try:
+        answers = read_answers(study, subject)
+        saved = len(answers)
+        done = {int(row["trial"]) for row in answers}
+        for trial in trials:
+            if trial["trial"] in done:
+                continue
             outcome = present(trial)
-        except KeyboardInterrupt:
-            outcome = None
-        if outcome is None:
-            return Progress(len(answers), len(trials) - len(answers), len(trials), interrupted=True)
-        answers.append(_answer_row(study, trial, *outcome, device_name))
-        _save(study.answers_path(subject), answers)
-    return Progress(len(answers), 0, len(trials))
+            if outcome is None:
+                break
+            answers.append(_answer_row(study, trial, *outcome, device_name))
+            _save(study, subject, answers)
+            saved = len(answers)
+        else:
+            return Progress(saved, len(trials) - saved, len(trials))
+    except KeyboardInterrupt:
+        try:
+            saved = len(read_answers(study, subject))
+        except (KeyboardInterrupt, InputError):
+            pass
+    return Progress(saved, len(trials) - saved, len(trials), interrupted=True)
 
 
 def _answer_row(study, trial, answer, seconds, toggles, device_name):
-    test, reference = study.surfaces[trial["test"]], study.surfaces[trial["reference"]]
-    rougher = int(trial[answer] == trial["test"])
     return {
         **{key: trial[key] for key in TRIAL_FIELDS},
         "answer": answer,
-        "test_rougher": rougher,
-        "reference_dimension": reference["dimension"],
-        "reference_rq_m": reference["rq"],
-        "test_dimension": test["dimension"],
-        "test_rq_m": test["rq"],
+        "test_rougher": int(trial[answer] == trial["test"]),
+        **_design_values(study, trial),
         "response_time_s": f"{seconds:.3f}",
         "toggles": toggles,
         "device": device_name,
-        "finished": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
+        "finished": datetime.datetime.now(datetime.timezone.utc).strftime(TIME_FORMAT),
     }
 
 
-def _save(path, rows):
+def _answers_file(study, subject):
+    """``answers/<subject>.csv``, made sure to lie inside the study folder: the answers
+    folder is a real folder, and the file a regular file or absent (not a link)."""
+    path = study.answers_path(subject)
+    if path.parent.is_symlink() or (path.parent.exists() and not path.parent.is_dir()):
+        raise InputError(f"{path.parent}: not a folder (answers are written only inside the study folder)")
+    if path.is_symlink() or (path.exists() and not path.is_file()):
+        raise InputError(f"{path}: not a regular file (answers are written only inside the study folder)")
+    return path
+
+
+def _save(study, subject, rows):
     from ..io.atomic import atomic_output
 
-    pathlib.Path(path).parent.mkdir(exist_ok=True)
+    path = _answers_file(study, subject)
+    path.parent.mkdir(exist_ok=True)
     text = io.StringIO()
     writer = csv.DictWriter(text, ANSWER_FIELDS, lineterminator="\n")
     writer.writeheader()

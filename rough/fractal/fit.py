@@ -244,10 +244,11 @@ def fit_fractal(surface, band=None, resolution=None, method="whittle", order=1, 
             band = ((band or (None, None))[0], default_top(surface, 0.5 / surface.spacing[0], sampling))
         levelled = detrend(surface, order=order).heights
         refuse_flat(levelled, surface.heights)
-        return fitter(levelled, surface.spacing[0], band, resolution, sampling)
+        return _announce_undefined(fitter(levelled, surface.spacing[0], band, resolution, sampling))
     if method != "whittle":
         raise InputError(f"maps are fitted by the Whittle method only, not {method}")
-    return _whittle_map(surface, order, band, resolution, sampling, sector)
+    fit = _whittle_map(surface, order, band, resolution, sampling, sector)
+    return fit if sector is not None else _announce_undefined(fit)
 
 
 # -- profiles: Whittle on the differences ------------------------------------------------
@@ -332,12 +333,15 @@ def warn_at_edge(where="", dimension="D at 1 or 2"):
     )
 
 
+UNDEFINED_CHECKED = ("fractal_dimension", "amplitude_coefficient", "psd_prefactor", "structure_function_coefficient")
+
+
 def _result(beta, covariance, prefactor, resolution, band, method, window, sampling, count):
     dimension = (5.0 - beta) / 2.0
     amplitude = model.amplitude(prefactor, dimension, resolution)
     gradient = np.array([1.0, math.log(resolution)])
     log_error = math.sqrt(max(gradient @ covariance @ gradient, 0.0))
-    return FractalFit(
+    fit = FractalFit(
         fractal_dimension=dimension,
         fractal_dimension_stderr=math.sqrt(max(covariance[1, 1], 0.0)) / 2,
         amplitude_coefficient=amplitude,
@@ -352,6 +356,20 @@ def _result(beta, covariance, prefactor, resolution, band, method, window, sampl
         frequencies_used=count,
         structure_function_coefficient=amplitude / model.structure_factor(dimension),
     )
+    return fit
+
+
+def _announce_undefined(fit):
+    """One warning naming every result that came out undefined (NaN or infinite)."""
+    values = {name: getattr(fit, name) for name in UNDEFINED_CHECKED}
+    values["band"] = min(fit.band, default=math.nan) if fit.band else math.nan
+    undefined = [name for name, value in values.items() if value is None or not math.isfinite(value)]
+    if undefined:
+        log.warning(
+            f"undefined for this surface: {', '.join(undefined)} (outside the range of float64 arithmetic at "
+            f"this spacing and height scale)"
+        )
+    return fit
 
 
 def _in_band(frequencies, band):

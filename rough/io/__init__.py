@@ -35,6 +35,7 @@ import zlib
 import numpy as np
 
 from ..errors import FormatError, InputError
+from . import limits
 
 FORMATS = {
     "x3p": "X3P (ISO 25178-72)",
@@ -61,8 +62,6 @@ _MAGIC = (
 )
 GZIP_MAGIC = b"\x1f\x8b"
 log = logging.getLogger("rough")
-MAX_UNPACKED_BYTES = 1 << 30
-BOMB_RATIO, BOMB_FLOOR = 1000, 64 << 20  # past 64 MB unpacked, a ratio over 1000:1 is a gzip bomb
 
 # What a malformed file makes the parsers raise; read() turns these into FormatError.
 _PARSE_ERRORS = (
@@ -174,6 +173,8 @@ def read_bytes(data, options=ReadOptions()):
         return _parse(data, options)
     except MemoryError:
         raise InputError("too large to read into memory") from None
+    except RecursionError:
+        raise FormatError(f"malformed {describe(sniff(data))} file (nested too deeply to read)") from None
     except _PARSE_ERRORS as error:
         raise FormatError(f"malformed {describe(sniff(data))} file ({error})") from error
 
@@ -181,16 +182,31 @@ def read_bytes(data, options=ReadOptions()):
 def _parse(data, options):
     if not data:
         raise FormatError("empty file, no surface to read")
-    if bytes(data[:2]) == GZIP_MAGIC:
-        return _parse(gunzip(data), options)
+    packed, layers = len(data), 0
+    while bytes(data[:2]) == GZIP_MAGIC:
+        layers += 1
+        if layers > limits.MAX_GZIP_LAYERS:
+            raise FormatError(f"gzip nested more than {limits.MAX_GZIP_LAYERS} deep; refusing")
+        data = gunzip(data, packed)
     format_name = sniff(data)
+    text_cap = limits.cap("MAX_TEXT_BYTES")
+    if format_name == "tsv" and len(data) > text_cap:
+        raise FormatError(
+            f"{limits.human(len(data))} of text is more than rough parses ({limits.human(text_cap)}); "
+            "convert it to X3P or NPY, or set ROUGH_MAX_TEXT_BYTES to raise the cap"
+        )
     with np.errstate(all="ignore"):
         surface = _module(format_name).read(data, options)
     surface.source_format = format_name
     if not np.isfinite(surface.heights).all():
         infinite = np.isinf(surface.heights)
         if infinite.any():
-            log.info("%d infinite heights marked invalid (NaN)", infinite.sum())
+            first = np.unravel_index(np.argmax(infinite), infinite.shape)[::-1]
+            log.warning(
+                "%d infinite heights marked invalid (NaN), the first at point %s",
+                infinite.sum(),
+                ", ".join(map(str, first)),
+            )
             surface.heights = np.where(infinite, np.nan, surface.heights)
     if surface.heights.size < 2:
         raise FormatError(f"holds {surface.heights.size} point; a surface needs at least two points")
@@ -289,23 +305,26 @@ def format_for_path(path):
     return EXTENSIONS[extension]
 
 
-def gunzip(data, limit=MAX_UNPACKED_BYTES):
-    """Unpack gzip data in chunks, refusing more than ``limit`` bytes, or a ratio of
-    unpacked to packed bytes beyond BOMB_RATIO once past BOMB_FLOOR (a gzip bomb)."""
-    unpacker = zlib.decompressobj(wbits=31)
-    parts, total, pending = [], 0, bytes(data)
-    while pending and not unpacker.eof:
-        part = unpacker.decompress(pending, 16 << 20)
-        pending = unpacker.unconsumed_tail
-        parts.append(part)
-        total += len(part)
-        consumed = len(data) - len(pending) - len(unpacker.unused_data)
-        if total > limit or (total > BOMB_FLOOR and total > BOMB_RATIO * max(consumed, 1)):
-            raise FormatError(
-                f"gzip data unpack to more than {total >> 20} MB from {consumed} bytes; refusing (a gzip bomb?)"
-            )
-    if not unpacker.eof:
-        raise FormatError("truncated gzip data")
+def gunzip(data, packed=None):
+    """Unpack gzip data, every member of it (``cat a.gz b.gz``), in chunks: refused
+    past the caps of :mod:`rough.io.limits`, counted against ``packed`` bytes (the
+    size of the file as given, for nested gzip)."""
+    budget = limits.Budget(packed or len(data), "gzip data")
+    parts, pending = [], bytes(data)
+    while pending:
+        unpacker = zlib.decompressobj(wbits=31)
+        while pending and not unpacker.eof:
+            part = unpacker.decompress(pending, min(limits.CHUNK << 4, budget.room()))
+            pending = unpacker.unconsumed_tail
+            budget.add(len(part))
+            parts.append(part)
+        if not unpacker.eof:
+            raise FormatError("truncated gzip data")
+        pending = unpacker.unused_data
+        if pending and pending[:2] != GZIP_MAGIC:
+            if pending.strip(b"\0"):
+                raise FormatError(f"{len(pending)} bytes of junk after the gzip data")
+            pending = b""
     return b"".join(parts)
 
 
@@ -318,15 +337,17 @@ def _module(format_name):
 def _slurp(source):
     """``(name for messages, bytes)`` of a path, ``'-'``, a stream or bytes."""
     if isinstance(source, (bytes, bytearray, memoryview)):
+        if len(source) > limits.cap("MAX_INPUT_BYTES"):
+            raise InputError(f"<bytes>: more than {limits.human(limits.cap('MAX_INPUT_BYTES'))}; refusing")
         return "<bytes>", source
     if source == "-" or source is sys.stdin:
         widen_pipe(sys.stdin)
-        return "<stdin>", sys.stdin.buffer.read()
+        return "<stdin>", limits.read_capped(sys.stdin.buffer, "<stdin>")
     if isinstance(source, (str, os.PathLike)):
         name = os.fspath(source)
         try:
             with open(name, "rb") as stream:
-                return name, stream.read()
+                return name, limits.read_capped(stream, name)
         except FileNotFoundError:
             raise InputError(f"{name}: no such file") from None
         except IsADirectoryError:
@@ -334,7 +355,8 @@ def _slurp(source):
         except PermissionError:
             raise InputError(f"{name}: permission denied") from None
     if isinstance(source, io.IOBase) or hasattr(source, "read"):
-        return getattr(source, "name", "<stream>"), source.read()
+        name = getattr(source, "name", "<stream>")
+        return name, limits.read_capped(source, name)
     raise InputError(f"cannot read a surface from {type(source).__name__}")
 
 

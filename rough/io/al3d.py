@@ -92,7 +92,7 @@ def _number(tags, key, default=None):
 
 
 def _length(tags, key):
-    value = abs(_number(tags, key))
+    value = _number(tags, key)
     if not (0 < value < np.inf):
         raise FormatError(f"AL3D tag {key} is {tags[key]!r}, not a pixel size")
     return value

@@ -25,7 +25,7 @@ import numpy as np
 from ..errors import FormatError
 from ..surface import Surface, Units
 from ..units import metres_per
-from . import provenance
+from . import limits, provenance
 
 HEIGHT_CHANNELS = ("Y", "Z", "R")
 MAX_POINTS = 1 << 31
@@ -36,7 +36,10 @@ def read(data, options):
     import OpenEXR
 
     with _library_quiet():
-        header = _open(OpenEXR, data, header_only=True).header()
+        parts = _open(OpenEXR, data, header_only=True).parts
+    if len(parts) > 1:
+        raise FormatError(f"EXR file holds {len(parts)} parts; rough reads single-part files (split it: exrmultipart)")
+    header = parts[0].header
     low, high = header["dataWindow"]
     nx, ny = int(high[0] - low[0] + 1), int(high[1] - low[1] + 1)
     if nx < 1 or ny < 1 or nx * ny > MAX_POINTS or nx * ny * 2 > MAX_EXPANSION * len(data):
@@ -139,8 +142,9 @@ def _scale_values(values, header):
     otherwise ``Gwy::ZScale`` is the value of 1.0 in the file."""
     if "Gwy::ZMax" in header:
         low = _double(header, "Gwy::ZMin", 0.0)
-        return low + values * (_double(header, "Gwy::ZMax") - low) / (2.0**32 - 1 + 0.999)
-    return values * _double(header, "Gwy::ZScale", 1.0)
+        factor = (_double(header, "Gwy::ZMax") - low) / (2.0**32 - 1 + 0.999)
+        return limits.scaled(values, factor, "EXR Gwy::ZMin and Gwy::ZMax", low)
+    return limits.scaled(values, _double(header, "Gwy::ZScale", 1.0), "EXR Gwy::ZScale")
 
 
 def _string(header, key):

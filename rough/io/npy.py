@@ -28,6 +28,8 @@ def read(data, options):
         raise FormatError(f"NPY array holds {dtype}, not numbers")
     if len(shape) not in (1, 2):
         raise FormatError(f"NPY array is {len(shape)}-D; a surface is 1-D (profile) or 2-D (map)")
+    if not all(isinstance(n, int) and n >= 0 for n in shape):
+        raise FormatError(f"NPY shape {shape} is not a list of sizes")
     count = int(np.prod(shape, dtype=object))
     available = len(data) - stream.tell()
     if count * dtype.itemsize > available:

@@ -31,5 +31,8 @@ def restore(stored, metadata=None, units=None):
     metadata = {**(metadata or {}), **{str(k): str(v) for k, v in given.get("metadata", {}).items()}}
     if "units" in given:
         units = Units(**{k: str(v) for k, v in given["units"].items() if k in ("xy", "z")})
-    history = [entry for entry in given.get("history", []) if isinstance(entry, dict)]
+    history = given.get("history", [])
+    for number, entry in enumerate(history, start=1):
+        if not isinstance(entry, dict) or not isinstance(entry.get("parameters", {}), dict):
+            raise FormatError(f"rough's history record in the file is damaged (entry {number} is malformed)")
     return metadata, units or Units(), history

@@ -15,6 +15,7 @@ import numpy as np
 
 from ..errors import FormatError
 from ..surface import Surface
+from . import limits
 
 BINARY_HEADER = struct.Struct("<8s10s12s12sHHddddBBB")
 DATA_TYPES = ("<u1", "<u2", "<u4", "<f4", "<i1", "<i2", "<i4", "<f8")
@@ -27,7 +28,7 @@ def read(data, options):
     else:
         header, values = _ascii(bytes(data).decode("latin-1"))
     nx, ny = header["NumPoints"], header["NumProfiles"]
-    heights = values.astype(np.float64) * header["Zscale"]
+    heights = limits.scaled(values.astype(np.float64), header["Zscale"], f"SDF Zscale {header['Zscale']!r}")
     spacing = (header["Xscale"], header["Yscale"])
     metadata = {"instrument": header.get("ManufacID", "")} if header.get("ManufacID") else {}
     if _date(header.get("CreateDate")):
@@ -61,6 +62,9 @@ def _ascii(text):
             f"SDF declares {header['NumPoints']}×{header['NumProfiles']} points but holds {len(body)} values"
         )
     values = np.array([np.nan if item.upper() == "BAD" else float(item) for item in body])
+    if np.isinf(values).any():
+        bad = body[int(np.argmax(np.isinf(values)))]
+        raise FormatError(f"SDF value {bad[:40]!r} is beyond the float64 range")
     return header, values
 
 

@@ -24,6 +24,7 @@ rows, as gnuplot expects), in metres, with every float printed to round-trip exa
 import io
 import json
 import re
+import unicodedata
 
 import numpy as np
 
@@ -36,12 +37,38 @@ from . import provenance
 _UNIT_IN_NAME = re.compile(r"[\[(]\s*([^\])]+?)\s*[\])]|\s([A-Za-zµμÅ]+)\s*$")
 _NUMERIC = re.compile(r"^[\s,;]*[+-]?(\d|\.\d|nan|inf|bad)", re.IGNORECASE)
 _BAD = re.compile(r"\bBAD\b", re.IGNORECASE)
+_NUMBER = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$")
+_MISTYPED_NUMBER = re.compile(r"^[+-]?[\dOoIl]*[\d.][\dOoIl.]*([eE][+-]?\d+)?$")
+_INFINITY = re.compile(r"^[+-]?inf(inity)?$", re.IGNORECASE)
+
+
+class _BadLine(FormatError):
+    """A problem in one line; read() adds the line's number."""
+
+    def __init__(self, line, problem):
+        super().__init__(problem)
+        self.line = line
 
 
 def read(data, options):
-    lines = [line for line in _decode(data).splitlines() if line.strip()]
+    raw = _decode(data).splitlines()
+    lines = [line for line in raw if line.strip()]
     if not lines:
         raise FormatError("empty text file, no surface to read")
+    try:
+        return _read_lines(lines, options)
+    except _BadLine as error:
+        raise FormatError(f"line {_line_number(raw, error.line)}: {error}") from None
+
+
+def _line_number(raw, line):
+    """The number of ``line`` in the file: the same string object where it was passed on
+    unchanged (a repeated line has several numbers), else the first equal line."""
+    same = next((i for i, candidate in enumerate(raw) if candidate is line), None)
+    return (raw.index(line) if same is None else same) + 1
+
+
+def _read_lines(lines, options):
     if any(line.strip() == "Scan Data" for line in lines[:200]):
         return _dektak(lines, options)
     if any(line.startswith("# Width:") for line in lines[:20]):
@@ -232,12 +259,26 @@ def _column_names(body):
     """Split off a line of column names and a line of units, if the data have them."""
     names, units_row = [], None
     if body and not _NUMERIC.match(body[0]):
-        names = _split(body[0], _delimiter(body[0]))
+        names = _names(body[0])
         body = body[1:]
         if body and not _NUMERIC.match(body[0]):
-            units_row = _split(body[0], _delimiter(body[0]))
+            units_row = _names(body[0])
             body = body[1:]
     return names, units_row, body
+
+
+def _names(line):
+    """The fields of a line of column names or units. A line in which a field is a
+    number, or a number with a letter for a digit (``O.5``, ``1l``), or that holds an
+    invisible formatting character, is a data line with a typo, not a header."""
+    fields = _split(line, _delimiter(line))
+    for field in fields:
+        hidden = [c for c in field if unicodedata.category(c) == "Cf"]
+        if hidden:
+            raise _BadLine(line, f"invisible character U+{ord(hidden[0]):04X} in {line!r}")
+        if _NUMBER.match(field) or _MISTYPED_NUMBER.match(field):
+            raise _BadLine(line, f"{line.strip()[:60]!r} is neither column names nor numbers (a typo in {field!r}?)")
+    return fields
 
 
 def _delimiter(line):
@@ -266,9 +307,19 @@ def _numbers(body, delimiter, columns):
     try:
         table = np.loadtxt(io.StringIO(block), delimiter=delimiter, usecols=tuple(columns), ndmin=2, comments=None)
     except ValueError as error:
+        row = re.search(r",? at row (\d+)", str(error))
+        if row and int(row.group(1)) < len(body):
+            line = body[int(row.group(1))]
+            problem = str(error)[: row.start()]
+            raise _BadLine(line, f"unreadable number in {line.strip()[:60]!r} ({problem})") from None
         raise FormatError(f"unreadable number in the data ({error})") from None
     if table.size == 0:
         raise FormatError("no numeric data found")
+    for row, column in np.argwhere(np.isinf(table)):
+        fields = _split(body[row], delimiter)
+        token = fields[columns[column]] if columns[column] < len(fields) else ""
+        if not _INFINITY.match(token):
+            raise _BadLine(body[row], f"the number {token[:40]!r} is beyond the float64 range")
     return table
 
 

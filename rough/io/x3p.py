@@ -20,6 +20,7 @@ vendor-specific member named by the root's ``VendorSpecificID``, which other rea
 ignore.
 """
 
+import bz2
 import hashlib
 import io
 import json
@@ -38,7 +39,7 @@ import numpy as np
 from .. import __version__
 from ..errors import FormatError
 from ..surface import Surface, Units, timestamp
-from . import provenance
+from . import limits, provenance
 
 NAMESPACE = "http://www.opengps.eu/2008/ISO5436_2"
 VENDOR_ID = "urn:x-rough:x3p-vendor:1"
@@ -163,28 +164,57 @@ def _member(archive, name, data, limit=None, expected=None, check_crc=True):
         raise FormatError(f"{name} holds {info.file_size} bytes, but the header implies {expected}")
     if limit is not None and info.file_size > limit:
         raise FormatError(f"{name} is {info.file_size} bytes, more than rough reads ({limit})")
-    if info.compress_type == zipfile.ZIP_STORED and not info.flag_bits & 0x1:
-        view = memoryview(data)
-        header = bytes(view[info.header_offset : info.header_offset + 30])
-        if len(header) < 30 or header[:4] != b"PK\x03\x04":
-            raise FormatError(f"damaged zip: no local header for {name}")
-        start = info.header_offset + 30 + sum(struct.unpack("<HH", header[26:30]))
+    if info.flag_bits & 0x1:
+        raise FormatError(f"{name} is encrypted; X3P members are plain")
+    view = memoryview(data)
+    header = bytes(view[info.header_offset : info.header_offset + 30])
+    if len(header) < 30 or header[:4] != b"PK\x03\x04":
+        raise FormatError(f"damaged zip: no local header for {name}")
+    start = info.header_offset + 30 + sum(struct.unpack("<HH", header[26:30]))
+    if info.compress_type == zipfile.ZIP_STORED:
         content = view[start : start + info.file_size]
         if len(content) != info.file_size:
             raise FormatError(f"truncated archive: {name} is cut short")
-        if check_crc and zlib.crc32(content) != info.CRC:
-            raise FormatError(f"{name} fails its zip CRC check: the archive is damaged")
-        return content
-    if info.flag_bits & 0x1:
-        raise FormatError(f"{name} is encrypted; X3P members are plain")
+    else:
+        content = _unpacked(info, view[start : start + info.compress_size], name)
+    if check_crc and zlib.crc32(content) != info.CRC:
+        raise FormatError(f"{name} fails its zip CRC check: the archive is damaged")
+    return content
+
+
+def _unpacked(info, packed, name):
+    """A compressed member unpacked in chunks, within the caps of rough.io.limits."""
+    limits.Budget(len(packed), name).add(info.file_size)  # the declared size alone may break the caps
+    budget, content = limits.Budget(len(packed), name), bytearray(info.file_size)
     try:
-        with archive.open(info) as member:
-            content = member.read(info.file_size + 1)
+        unpacker, packed = _unpacker(info, bytes(packed), name)
+        while not unpacker.eof:
+            part = unpacker.decompress(packed, min(budget.room(), info.file_size - budget.total + 1))
+            packed = getattr(unpacker, "unconsumed_tail", b"")
+            if not part and getattr(unpacker, "needs_input", not packed):
+                break
+            if budget.total + len(part) > info.file_size:
+                break
+            content[budget.total : budget.total + len(part)] = part
+            budget.add(len(part))
     except ZIP_ERRORS as error:
         raise FormatError(f"{name} cannot be unpacked ({type(error).__name__}: {error})") from None
-    if len(content) != info.file_size:
+    if not unpacker.eof or budget.total != info.file_size:
         raise FormatError(f"{name} does not hold the {info.file_size} bytes its zip entry declares")
     return content
+
+
+def _unpacker(info, packed, name):
+    """The decompressor of a zip member and the bytes to feed it."""
+    if info.compress_type == zipfile.ZIP_DEFLATED:
+        return zlib.decompressobj(-15), packed
+    if info.compress_type == zipfile.ZIP_BZIP2:
+        return bz2.BZ2Decompressor(), packed
+    if info.compress_type == zipfile.ZIP_LZMA and len(packed) > 4:  # zip's LZMA: version, size, properties
+        size = struct.unpack("<H", packed[2:4])[0]
+        properties = lzma._decode_filter_properties(lzma.FILTER_LZMA1, packed[4 : 4 + size])
+        return lzma.LZMADecompressor(lzma.FORMAT_RAW, filters=[properties]), packed[4 + size :]
+    raise FormatError(f"{name} cannot be unpacked (zip compression method {info.compress_type})")
 
 
 def _parse_xml(document):
@@ -331,9 +361,10 @@ def _list_records(root, fields, count):
 
 def _scaled(raw, axis):
     values = raw.astype(np.float64) if raw.dtype != np.float64 else raw
-    if axis["code"] in ("I", "L"):
-        values = values * axis["increment"]
-    return values + axis["offset"] if axis["offset"] else values
+    factor = axis["increment"] if axis["code"] in ("I", "L") else 1.0
+    if factor == 1.0 and not axis["offset"]:
+        return values
+    return limits.scaled(values, factor, f"the Increment {factor!r} and Offset {axis['offset']!r}", axis["offset"])
 
 
 def _grid(name, axis, records, valid, n, nx, ny):

@@ -252,6 +252,12 @@ def _announce_undefined(values):
         named = [key for key in keys if key in undefined]
         if named:
             reasons.append(f"{', '.join(named)} ({reason})")
+    explained = {key for keys in UNDEFINED.values() for key in keys}
+    others = sorted(undefined - explained)
+    if others:
+        reasons.append(
+            f"{', '.join(others)} (outside the range of float64 arithmetic at this spacing and height scale)"
+        )
     if reasons:
         log.warning(f"undefined for this surface: {'; '.join(reasons)}")
 

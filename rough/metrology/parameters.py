@@ -470,10 +470,11 @@ def autocorrelation_lengths(surface, threshold=0.2, directions=360):
     acf, lag_x, lag_y = autocorrelation(surface)
     dx, dy = surface.spacing
     cy, cx = (acf.shape[0] - 1) / 2, (acf.shape[1] - 1) / 2
-    step = min(dx, dy) / 4
+    finest = min(dx, dy) / 4
     decay, reaches = np.full(directions, np.nan), np.empty(directions)
     for k, angle in enumerate(np.linspace(0, np.pi, directions, endpoint=False)):
         reach = reaches[k] = min(lag_x[-1] / max(abs(math.cos(angle)), 1e-12), lag_y[-1] / max(math.sin(angle), 1e-12))
+        step = max(finest, reach / (4 * max(acf.shape)))  # at most 4 samples a lag when dx and dy differ wildly
         radii = np.arange(0, reach + step / 2, step)
         along = map_coordinates(acf, [cy + radii * math.sin(angle) / dy, cx + radii * math.cos(angle) / dx], order=1)
         below = np.flatnonzero(along <= threshold)

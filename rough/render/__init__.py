@@ -90,6 +90,13 @@ def simulate(
     Run
         The trace and timing of the run, with ``speed`` set.
 
+    Raises
+    ------
+    rough.InputError
+        Before it starts, for a run whose trace would exceed
+        :data:`~rough.render.loop.TRACE_LIMIT` (512 MiB: duration × rate past
+        :data:`~rough.render.loop.MAX_TICKS`).
+
     See Also
     --------
     forces : Force statistics of the run.

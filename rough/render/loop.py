@@ -31,11 +31,32 @@ import time
 
 import numpy as np
 
-from ..errors import RoughError
+from ..errors import InputError, RoughError
 from .contact import MAX_FORCE, clamp
 
 SPIN = 2e-4  # s before each deadline spent spinning instead of sleeping
 TRACE_FIELDS = ("t", "x", "y_i", "h", "F_x", "F_y", "contact")
+TICK_BYTES = 8 * (len(TRACE_FIELDS) + 2)  # a trace row, and a real-time tick's start and deadline
+TRACE_LIMIT = 512 * 2**20  # bytes a run's trace may take: 7.4 million ticks, 2 hours at 1 kHz
+MAX_TICKS = TRACE_LIMIT // TICK_BYTES
+
+
+def check_ticks(ticks, what="the run"):
+    """Refuse ``ticks`` (in all) past :data:`MAX_TICKS`, before anything starts."""
+    if not ticks <= MAX_TICKS:
+        raise InputError(
+            f"{what} would take {ticks:.4g} ticks (run time × rate), {ticks * TICK_BYTES / 2**20:.4g} MiB of trace: "
+            f"over the bound of {TRACE_LIMIT // 2**20} MiB ({MAX_TICKS} ticks, {MAX_TICKS / 3.6e6:.3g} hours at 1 kHz)"
+        )
+
+
+def planned_ticks(settings, duration=None):
+    """The ticks a run of ``duration`` (default ``settings.duration``) takes; None without one."""
+    duration = settings.duration if duration is None else duration
+    if duration is None:
+        return None
+    ticks = duration * settings.rate
+    return max(1, round(ticks)) if ticks <= MAX_TICKS else ticks
 
 
 class LoopStalled(RoughError):
@@ -118,8 +139,9 @@ class Run:
     switches : int
         How many times the trigger switched between two surfaces.
     ended_by : str
-        ``"duration"``, ``"answer"`` (``until`` returned an answer) or
-        ``"interrupt"`` (Ctrl-C).
+        ``"duration"``, ``"answer"`` (``until`` returned an answer),
+        ``"interrupt"`` (Ctrl-C) or ``"trace limit"`` (a run without a duration
+        reached :data:`MAX_TICKS`).
     speed : float or None
         The stroking speed of a simulated run, m/s.
     device : str
@@ -238,6 +260,10 @@ def run(device, tracks, model, friction=None, settings=None, until=None):
 
     Raises
     ------
+    rough.InputError
+        Before anything starts, when ``settings.duration × settings.rate`` exceeds
+        :data:`MAX_TICKS` (a trace over :data:`TRACE_LIMIT` bytes). A run without a
+        duration ends at that many ticks.
     rough.RoughError
         ``LoopStalled`` when the watchdog found the loop stalled and zeroed the
         force (devices that need a watchdog, in real time).
@@ -271,6 +297,11 @@ def run(device, tracks, model, friction=None, settings=None, until=None):
     (10, 'answer', 'enough')
     """
     settings = settings or Settings()
+    try:
+        check_ticks(planned_ticks(settings) or 0)
+    except InputError:
+        device.close()
+        raise
     model.reset()
     if friction is not None:
         friction.reset()
@@ -321,7 +352,7 @@ class _Loop:
         self.device, self.tracks, self.model, self.friction = device, list(tracks), model, friction
         self.until, self.answer = until, None
         self.settings, self.watchdog = settings, watchdog
-        self.rows, self.starts, self.deadlines = array.array("d"), [], []
+        self.rows, self.starts, self.deadlines = array.array("d"), array.array("d"), array.array("d")
         self.ticks, self.missed, self.switches = 0, 0, 0
         self.ended_by = "duration"
         self.wall_time = 0.0
@@ -330,7 +361,7 @@ class _Loop:
     def spin(self):
         s = self.settings
         period, realtime, limit = s.period, s.realtime, s.max_force
-        total = None if s.duration is None else max(1, round(s.duration * s.rate))
+        total = planned_ticks(s) or MAX_TICKS
         ramp_ticks = s.ramp * s.rate
         alpha = 1.0 - math.exp(-2.0 * math.pi * s.velocity_cutoff * period)
         read, write, step = self.device.read, self.device.write, self.model.step
@@ -347,7 +378,7 @@ class _Loop:
         deadline = begin
         k = 0
         try:
-            while total is None or k < total:
+            while k < total:
                 if realtime:
                     now = clock()
                     if now - deadline >= period:
@@ -398,6 +429,8 @@ class _Loop:
                 write(fx, fy)
                 record((k * period, x, y, h, fx, fy, contact))
                 k += 1
+            if k == total and s.duration is None:
+                self.ended_by = "trace limit"
         finally:
             self.ticks = k
             self.wall_time = clock() - begin
@@ -410,10 +443,10 @@ class _Loop:
         for index, name in enumerate(TRACE_FIELDS):
             trace[name] = columns[:, index]
         trace["h"][~np.isfinite(trace["h"])] = np.nan
-        if self.starts:
-            trace["t"] = np.asarray(self.starts[: trace.size]) - self.starts[0]
-        starts = np.asarray(self.starts) if self.starts else None
-        deadlines = np.asarray(self.deadlines) if self.deadlines else None
+        starts = np.frombuffer(self.starts, dtype=np.float64) if self.starts else None
+        deadlines = np.frombuffer(self.deadlines, dtype=np.float64) if self.deadlines else None
+        if starts is not None:
+            trace["t"] = starts[: trace.size] - starts[0]
         return Run(
             trace,
             self.ticks,

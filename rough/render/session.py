@@ -4,7 +4,7 @@ more speeds, or a joystick until Ctrl-C; and their summary for people and progra
 from ..units import format_unit
 from . import forces, simulate
 from .contact import DynamicStylus, QuasiStatic
-from .loop import run
+from .loop import check_ticks, planned_ticks, run
 
 
 def make_model(name, stiffness, mass, damping, period):
@@ -15,8 +15,17 @@ def make_model(name, stiffness, mass, damping, period):
 
 
 def run_sim(track, speeds, model, friction, settings, **hand):
-    """One simulated stroke per speed: ``[(label, Run), ...]`` with labels like ``20mm_s``."""
-    return [(f"{speed * 1e3:g}mm_s", simulate(track, speed, model, friction, settings, **hand)) for speed in speeds]
+    """One simulated stroke per speed: ``[(label, Run), ...]`` with labels like ``20mm_s``.
+    Refuses the runs before the first starts if their traces together would exceed the
+    bound (:data:`~rough.render.loop.TRACE_LIMIT`); Ctrl-C ends the last run begun."""
+    ticks = sum(planned_ticks(settings, settings.duration or track.length / speed) for speed in speeds)
+    check_ticks(ticks, "the run" if len(speeds) == 1 else f"the {len(speeds)} runs")
+    runs = []
+    for speed in speeds:
+        runs.append((f"{speed * 1e3:g}mm_s", simulate(track, speed, model, friction, settings, **hand)))
+        if runs[-1][1].ended_by == "interrupt":
+            break
+    return runs
 
 
 def open_joystick(spec, tracks, max_force, stick_span=None, invert=()):
@@ -40,6 +49,7 @@ def open_joystick(spec, tracks, max_force, stick_span=None, invert=()):
 
 def run_hid(spec, tracks, model, friction, settings, stick_span=None, invert=()):
     """A session on the joystick ``spec`` until the duration passes or Ctrl-C: ``("hid", Run)``."""
+    check_ticks(planned_ticks(settings) or 0)
     joystick, label = open_joystick(spec, tracks, settings.max_force, stick_span, invert)
     result = run(joystick, tracks, model, friction, settings)
     result.device = label

@@ -276,7 +276,7 @@ def text_cases():
     case("text-duplicate-x.txt", b"x z\n1 1\n1 2\n1 3\n", "", "every x the same: zero spacing")
     case("text-single-point.txt", b"x z\n0 1e-6\n", "two points", "one row")
     case("text-nan-only.txt", b"x z\n0 nan\n1 nan\n2 nan\n", "no valid points", "every height NaN")
-    case("text-overflow.txt", b"x z\n0 1e400\n1 1e400\n2 -1e400\n", "no valid points", "heights overflow to infinity")
+    case("text-overflow.txt", b"x z\n0 1e400\n1 1e400\n2 -1e400\n", "line 2", "heights overflow to infinity")
     case("text-bom-only.txt", b"\xef\xbb\xbf", "empty", "a UTF-8 byte-order mark and nothing else")
     case(
         "text-utf16-odd-length.txt",
@@ -441,6 +441,112 @@ def _gzip_of_zeros(size):
     return b"".join(parts) + packer.flush()
 
 
+# -- issue 14: silent changes, internal errors, bombs past the bounds ----------------------------------
+
+
+def _rough_file(surface, format_name):
+    buffer = io.BytesIO()
+    surface.write(buffer, format_name)
+    return buffer.getvalue()
+
+
+def _lines_gzip(line, size):
+    """gzip of ``line`` repeated to ``size`` bytes, streamed."""
+    packer = zlib.compressobj(9, zlib.DEFLATED, 31)
+    chunk = line * ((1 << 20) // len(line))
+    return b"".join(packer.compress(chunk) for _ in range(size // len(chunk))) + packer.flush()
+
+
+def hardening_cases():
+    from rough import Surface
+
+    profile = b"x z\n0 1\n1 2\n2 3\n"
+    case("text-header-typo.txt", b"O.5 1.2\n1 2\n2 3\n", "neither column names", "first data row O.5 (a letter O)")
+    case("text-number-typo.txt", b"0.O 1.2\n1 2\n2 3\n", "line 1", "first data row 0.O (a letter O)")
+    case("text-rtl-override.txt", "\u202e0 1.2\n1 2\n2 3\n".encode(), "U+202E", "a leading right-to-left override")
+    case(
+        "text-huge-number.txt.gz",
+        gzip.compress(b"x z\n0 1\n1 " + b"1" * 500001 + b"\n2 3\n", 9),
+        "float64 range",
+        "a 500,001-digit height",
+    )
+    case("text-bomb.txt.gz", _lines_gzip(b"0 0\n", 60 << 20), "compression bomb", "61 KB of gzip, 60 MiB of text")
+    sdf_text = b"aISO-1.0\nNumPoints = 4000\nNumProfiles = 4000\nXscale = 1e-6\nYscale = 1e-6\nZscale = 1e-6\n*\n"
+    case(
+        "sdf-bomb.sdf.gz",
+        gzip.compress(sdf_text + b"0 " * (32 << 20) + b"\n*\n", 9),
+        "compression bomb",
+        "a gzipped ASCII SDF of 64 MiB",
+    )
+    twelve = " ".join(str(v) for v in range(12))
+    case(
+        "sdf-zscale-overflow.sdf",
+        f"aISO-1.0\nNumPoints = 4\nNumProfiles = 3\nXscale = 1\nYscale = 1\nZscale = 1e308\n*\n{twelve}\n*\n".encode(),
+        "Zscale",
+        "Zscale 1e308 overflows 10 of 12 heights",
+    )
+    case(
+        "npy-negative-shape.npy",
+        npy({"descr": "<f8", "fortran_order": False, "shape": (-1, 4)}, bytes(64)),
+        "shape",
+        "shape (-1, 4): numpy would infer 2 rows",
+    )
+    case("al3d-negative-pixel.al3d", al3d_file(np.zeros((2, 2)), pixel=(-1e-6, 1e-6)), "pixel size", "pixel size -1 µm")
+    import OpenEXR
+
+    parts = [
+        OpenEXR.Part({"type": OpenEXR.scanlineimage}, {"Y": np.full((3, 4), k, np.float32)}, f"part{k}") for k in (1, 2)
+    ]
+    buffer = io.BytesIO()
+    OpenEXR.File(parts).write(buffer)
+    case("exr-two-parts.exr", buffer.getvalue(), "2 parts", "a second part would be ignored")
+    damaged = Surface(GRID, (1e-6, 1e-6), history=[{"command": "synth", "parameters": [1, 2]}])
+    for format_name, suffix in (("x3p", "x3p"), ("exr", "exr"), ("gsf", "gsf"), ("tsv", "txt")):
+        case(
+            f"{format_name}-history-not-object.{suffix}",
+            _rough_file(damaged, format_name),
+            "history",
+            "a history entry whose parameters are a list",
+        )
+    deep = b'{"metadata": ' + b"[" * 100000 + b"]" * 100000 + b"}"
+    case(
+        "x3p-deep-json.x3p",
+        _swap_member(_rough_file(Surface(GRID, (1e-6, 1e-6)), "x3p"), "vendor/rough.json", deep),
+        "nested too deeply",
+        "vendor JSON nested 100,000 deep",
+    )
+    layered = profile
+    for _ in range(1100):
+        layered = gzip.compress(layered, 9, mtime=0)
+    case("gzip-nested.txt.gz", layered, "nested more than", "a profile gzipped 1,100 times")
+    case("gzip-junk-after.txt.gz", gzip.compress(profile) + b"junk", "junk", "bytes after the gzip member")
+    case(
+        "x3p-deflate-ratio.x3p",
+        x3p_file(np.zeros((1024, 1024))),
+        "compression bomb",
+        "data.bin deflates 1000:1 (8 MiB of zeros)",
+    )
+    xml = x3p_file(GRID, compression=zipfile.ZIP_STORED)
+    main = zipfile.ZipFile(io.BytesIO(xml)).read("main.xml")
+    for method, label in ((zipfile.ZIP_BZIP2, "bzip2"), (zipfile.ZIP_LZMA, "lzma")):
+        case(
+            f"x3p-{label}-main.x3p",
+            _recompress(xml, "main.xml", main + b" " * (64 << 20), method),
+            "compression bomb",
+            f"main.xml is {label} of 64 MiB",
+        )
+
+
+def _recompress(blob, name, content, method):
+    archive = zipfile.ZipFile(io.BytesIO(blob))
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(buffer, "w") as out:
+        for info in archive.infolist():
+            data = content if info.filename == name else archive.read(info)
+            out.writestr(info.filename, data, compress_type=method if info.filename == name else zipfile.ZIP_STORED)
+    return buffer.getvalue()
+
+
 def main():
     x3p_cases()
     exr_cases()
@@ -450,6 +556,7 @@ def main():
     sdf_cases()
     al3d_cases()
     other_cases()
+    hardening_cases()
     for old in HERE.iterdir():
         if old.suffix not in (".py", ".tsv") and old.is_file():
             old.unlink()

@@ -1,0 +1,113 @@
+"""How much input rough reads, for every container and codec alike.
+
+The caps are module constants; an environment variable of the same name raises
+(or lowers) each one, e.g. ``ROUGH_MAX_INPUT_BYTES=12G``. Compressed data are
+counted while they are unpacked, never unpacked first and checked after.
+
+MAX_INPUT_BYTES   bytes a file, standard input, or any unpacked stream may reach. A
+                  16384² float64 map (rough's largest surface) is 2 GiB; 3 GiB
+                  leaves room for its mask and header, and still leaves a 24 GiB
+                  machine the ~6 GiB that analysing such a map takes.
+MAX_RATIO         unpacked bytes per packed byte. Measured heights compress 2–10:1;
+                  deflate's ceiling is ~1030:1, reached only by constant data, which
+                  is what a bomb holds. Checked once past RATIO_FLOOR unpacked.
+MAX_TEXT_BYTES    bytes of text parsed: text takes ~15 bytes of memory per byte to
+                  parse, so 256 MiB (a 2000² x y z map) needs ~4 GiB; larger
+                  surfaces belong in X3P or NPY.
+MAX_GZIP_LAYERS   gzip inside gzip, at most this deep.
+"""
+
+import io
+import os
+import re
+import stat
+
+import numpy as np
+
+from ..errors import FormatError, InputError
+
+MAX_INPUT_BYTES = 3 << 30
+MAX_RATIO = 100
+MAX_TEXT_BYTES = 256 << 20
+RATIO_FLOOR = 1 << 20
+MAX_GZIP_LAYERS = 4
+CHUNK = 1 << 20
+
+_SIZE = re.compile(r"^\s*(\d+(?:\.\d+)?)\s*([KMGT]?)(?:i?B)?\s*$", re.IGNORECASE)
+
+
+def cap(name):
+    """The cap ``name`` (e.g. ``"MAX_INPUT_BYTES"``): ``ROUGH_<name>`` from the
+    environment if set (``4G``, ``512M``, ``1000``), else the module constant."""
+    text = os.environ.get(f"ROUGH_{name}")
+    if not text:
+        return globals()[name]
+    match = _SIZE.match(text)
+    if not match:
+        raise InputError(f"ROUGH_{name}={text!r} is not a number (write e.g. 4G, 512M or 1000)")
+    return int(float(match.group(1)) * 1024 ** "_KMGT".index(match.group(2).upper() or "_"))
+
+
+def human(size):
+    for shift, unit in ((30, "GiB"), (20, "MiB"), (10, "KiB")):
+        if size >= 1 << shift:
+            return f"{size / (1 << shift):.3g} {unit}"
+    return f"{size} bytes"
+
+
+class Budget:
+    """Counts unpacked bytes against MAX_INPUT_BYTES and MAX_RATIO × ``packed``."""
+
+    def __init__(self, packed, what, limit=None):
+        self.packed, self.what, self.total = max(packed, 1), what, 0
+        self.limit = min(cap("MAX_INPUT_BYTES"), limit or float("inf"))
+        self.ratio = cap("MAX_RATIO")
+
+    def room(self):
+        """Bytes that may still be unpacked, plus one to notice going over."""
+        return int(min(self.limit, max(RATIO_FLOOR, self.ratio * self.packed)) - self.total + 1)
+
+    def add(self, count):
+        self.total += count
+        if self.total > self.limit:
+            raise FormatError(
+                f"{self.what} unpacks to more than {human(self.limit)}; refusing "
+                "(set ROUGH_MAX_INPUT_BYTES to raise the cap)"
+            )
+        if self.total > RATIO_FLOOR and self.total > self.ratio * self.packed:
+            raise FormatError(
+                f"{self.what} unpacks to more than {self.ratio}× its {human(self.packed)} (a compression bomb?); "
+                "refusing (set ROUGH_MAX_RATIO to raise the cap)"
+            )
+
+
+def read_capped(stream, what, limit=None):
+    """All of ``stream``, read in chunks, refused past MAX_INPUT_BYTES (or ``limit``)."""
+    limit = min(cap("MAX_INPUT_BYTES"), limit or float("inf"))
+    try:
+        status = os.fstat(stream.fileno())
+    except (OSError, AttributeError, ValueError, io.UnsupportedOperation):
+        status = None
+    if status is not None and stat.S_ISREG(status.st_mode):
+        if status.st_size > limit:
+            raise _too_large(what, limit)
+        return stream.read()
+    parts, total = [], 0
+    while part := stream.read(min(CHUNK << 4, limit + 1 - total)):
+        parts.append(part)
+        total += len(part)
+        if total > limit:
+            raise _too_large(what, limit)
+    return b"".join(parts)
+
+
+def _too_large(what, limit):
+    return InputError(f"{what}: larger than {human(limit)}; refusing (set ROUGH_MAX_INPUT_BYTES to raise the cap)")
+
+
+def scaled(values, factor, what, offset=0.0):
+    """``values * factor + offset``, refusing a scale that turns finite values infinite."""
+    result = values * factor + offset if offset else values * factor
+    if not np.isfinite(result[np.isfinite(values)]).all():
+        raise FormatError(f"{what} scales heights beyond the float64 range")
+    return result
