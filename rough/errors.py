@@ -37,10 +37,20 @@ class InputError(RoughError):
     is needed, invalid points where the spectrum needs gap-free data), or a value out
     of range.
 
+    Parameters
+    ----------
+    message : str
+        What is wrong, in one line.
+    filename : str, optional
+        The output the message is about, where it is not the input (the command line
+        then puts no input name in front of the message).
+
     Attributes
     ----------
     exit_code : int
         The command line's exit status for bad input: 2.
+    filename : str or None
+        As given.
 
     See Also
     --------
@@ -57,6 +67,10 @@ class InputError(RoughError):
     """
 
     exit_code = 2
+
+    def __init__(self, message, filename=None):
+        super().__init__(message)
+        self.filename = filename
 
 
 class FormatError(InputError):

@@ -31,9 +31,7 @@ def save(figure, path):
     extension = os.path.splitext(os.fspath(path))[1].lstrip(".").lower() or "png"
     try:
         if os.fspath(path) == "-" and sys.stdout is not None and sys.stdout.isatty():
-            refusal = InputError("refusing to write a plot to a terminal: give a file name or a pipe")
-            refusal.filename = "-"
-            raise refusal
+            raise InputError("refusing to write a plot to a terminal: give a file name or a pipe", filename="-")
         with atomic_output(path) as stream:
             figure.savefig(stream, format=extension, dpi=150, bbox_inches="tight")
     finally:

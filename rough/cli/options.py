@@ -191,7 +191,7 @@ def input_options(spacing_flag="--spacing", most=1):
                 return command(*args, surface=surfaces[0], input=input, **kwargs)
             except InputError as error:
                 shown = "<stdin>" if names[0] == "-" else names[0]
-                if len(names) > 1 or hasattr(error, "filename") or str(error).startswith(f"{shown}: "):
+                if len(names) > 1 or error.filename is not None or str(error).startswith(f"{shown}: "):
                     raise
                 raise type(error)(f"{shown}: {error}") from error
 
@@ -277,11 +277,10 @@ class Output:
         from ..io.atomic import atomic_output, standard_output
 
         if self.path == "-" and self.format in BINARY and standard_output() and sys.stdout.isatty():
-            error = InputError(
-                f"refusing to write binary {self.format.upper()} to a terminal: use -o FILE, a pipe, or -f tsv"
+            raise InputError(
+                f"refusing to write binary {self.format.upper()} to a terminal: use -o FILE, a pipe, or -f tsv",
+                filename="-",
             )
-            error.filename = "-"
-            raise error
         if self.path != "-":
             write(surface, self.path, format=self.format)
             return

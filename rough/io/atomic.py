@@ -46,7 +46,7 @@ def atomic_output(path):
     except OSError as error:
         raise OSError(error.errno, error.strerror, path) from None
     if mode is not None and stat.S_ISDIR(mode):
-        raise _refusal(path, "is a folder, not a file to write")
+        raise InputError(f"{path}: is a folder, not a file to write", filename=path)
     if mode is not None and not stat.S_ISREG(mode):
         with _named(path), io.BufferedWriter(_Unseekable(os.open(path, os.O_WRONLY | os.O_NOCTTY), "wb")) as stream:
             yield stream
@@ -54,7 +54,9 @@ def atomic_output(path):
     target = os.path.realpath(path)
     directory = os.path.dirname(target)
     if not os.path.isdir(directory):
-        raise _refusal(path, f"cannot write, folder {os.path.dirname(os.path.abspath(path))} does not exist")
+        raise InputError(
+            f"{path}: cannot write, folder {os.path.dirname(os.path.abspath(path))} does not exist", filename=path
+        )
     temporary = None
     try:
         with _named(path):
@@ -84,12 +86,6 @@ class _Unseekable(io.FileIO):
 
     def seek(self, *args):
         raise io.UnsupportedOperation("not seekable")
-
-
-def _refusal(path, problem):
-    error = InputError(f"{path}: {problem}")
-    error.filename = path  # the command line puts no input name in front
-    return error
 
 
 @contextlib.contextmanager

@@ -58,9 +58,9 @@ def human(size):
 class Budget:
     """Counts unpacked bytes against MAX_INPUT_BYTES and MAX_RATIO × ``packed``."""
 
-    def __init__(self, packed, what, limit=None):
+    def __init__(self, packed, what):
         self.packed, self.what, self.total = max(packed, 1), what, 0
-        self.limit = min(cap("MAX_INPUT_BYTES"), limit or float("inf"))
+        self.limit = cap("MAX_INPUT_BYTES")
         self.ratio = cap("MAX_RATIO")
 
     def room(self):
@@ -81,9 +81,9 @@ class Budget:
             )
 
 
-def read_capped(stream, what, limit=None):
-    """All of ``stream``, read in chunks, refused past MAX_INPUT_BYTES (or ``limit``)."""
-    limit = min(cap("MAX_INPUT_BYTES"), limit or float("inf"))
+def read_capped(stream, what):
+    """All of ``stream``, read in chunks, refused past MAX_INPUT_BYTES."""
+    limit = cap("MAX_INPUT_BYTES")
     try:
         status = os.fstat(stream.fileno())
     except (OSError, AttributeError, ValueError, io.UnsupportedOperation):

@@ -183,23 +183,22 @@ def _member(archive, name, data, limit=None, expected=None, check_crc=True):
 
 
 def _unpacked(info, packed, name):
-    """A compressed member unpacked in chunks, within the caps of rough.io.limits."""
-    limits.Budget(len(packed), name).add(info.file_size)  # the declared size alone may break the caps
-    budget, content = limits.Budget(len(packed), name), bytearray(info.file_size)
+    """A compressed member unpacked in chunks, never past the size its entry declares,
+    which must itself be within the caps of rough.io.limits."""
+    limits.Budget(len(packed), name).add(info.file_size)
+    content, filled = bytearray(info.file_size), 0
     try:
         unpacker, packed = _unpacker(info, bytes(packed), name)
         while not unpacker.eof:
-            part = unpacker.decompress(packed, min(budget.room(), info.file_size - budget.total + 1))
+            part = unpacker.decompress(packed, min(limits.CHUNK << 4, info.file_size - filled + 1))
             packed = getattr(unpacker, "unconsumed_tail", b"")
-            if not part and getattr(unpacker, "needs_input", not packed):
+            if (not part and getattr(unpacker, "needs_input", not packed)) or filled + len(part) > info.file_size:
                 break
-            if budget.total + len(part) > info.file_size:
-                break
-            content[budget.total : budget.total + len(part)] = part
-            budget.add(len(part))
+            content[filled : filled + len(part)] = part
+            filled += len(part)
     except ZIP_ERRORS as error:
         raise FormatError(f"{name} cannot be unpacked ({type(error).__name__}: {error})") from None
-    if not unpacker.eof or budget.total != info.file_size:
+    if not unpacker.eof or filled != info.file_size:
         raise FormatError(f"{name} does not hold the {info.file_size} bytes its zip entry declares")
     return content
 
