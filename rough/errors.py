@@ -92,5 +92,5 @@ class FormatError(InputError):
     ...     rough.read(b"\\x00\\x01 not a surface")
     ... except FormatError as error:
     ...     print(error)
-    <bytes>: not a surface file rough can read (unrecognised binary data)
+    <bytes>: not a surface file rough can read (unrecognised binary data); rough reads al3d, bcr, di, ...
     """

@@ -17,6 +17,14 @@ EXTRAS = {
     "hidraw": ("the HID joystick", "hidapi", "haptics"),
     "hidtools": ("the HID joystick", "hid-tools", "haptics"),
     "statsmodels": ("the experiment's analysis", "statsmodels", "experiment"),
+    "h5py": ("reading HDF5", "h5py", "formats"),
+    "igor2": ("reading Igor IBW", "igor2", "formats"),
+    "openpyxl": ("reading Mitutoyo Excel files", "openpyxl", "formats"),
+    "olefile": ("reading MountainsMap MNT", "olefile", "formats"),
+    "zstandard": ("reading Keyence ZON", "zstandard", "formats"),
+    "gwyfile": ("reading and writing Gwyddion GWY", "gwyfile", "formats"),
+    "rasterio": ("reading and writing GeoTIFF", "rasterio", "formats"),
+    "tifffile": ("reading TIFF", "tifffile", "formats"),
 }
 
 

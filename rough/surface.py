@@ -217,7 +217,7 @@ class Surface:
         bounds = [x, y][: self.heights.ndim]
         slices, origin = [], []
         for axis, bound in enumerate(bounds):
-            start, stop = _index_range(bound, self.origin[axis], self.spacing[axis], self.points[axis], "xy"[axis])
+            start, stop = index_range(bound, self.origin[axis], self.spacing[axis], self.points[axis], "xy"[axis])
             slices.append(slice(start, stop))
             origin.append(self.origin[axis] + start * self.spacing[axis])
         index = tuple(reversed(slices))
@@ -279,9 +279,11 @@ def _check_spacing(spacing):
         )
 
 
-def _index_range(bound, origin, spacing, count, name):
+def index_range(bound, origin, spacing, count, name):
     """``(start, stop)`` sample indices of the positions between ``bound = (low, high)``
-    (either may be None), ends rounded to the nearest sample."""
+    (metres, either may be None) on the axis ``name`` of ``count`` samples from
+    ``origin``, ends rounded to the nearest sample, as :meth:`Surface.crop` keeps them
+    (readers of windows use it too). Raises InputError for fewer than two samples."""
     if bound is None:
         return 0, count
     low, high = bound
@@ -289,7 +291,8 @@ def _index_range(bound, origin, spacing, count, name):
     stop = count if high is None else min(count, int(np.floor((high - origin) / spacing + 0.5)) + 1)
     if stop - start < 2:
         last = origin + spacing * (count - 1)
+        ends = ":".join("" if end is None else f"{end:g}m" for end in bound)
         raise InputError(
-            f"the {name} range {bound} holds fewer than two samples (the data span {origin:g} to {last:g} m)"
+            f"the {name} range {ends} holds fewer than two samples (the data span {origin:g} m to {last:g} m)"
         )
     return start, stop

@@ -39,9 +39,9 @@ def mutated(draw, seed):
     return bytes(data)
 
 
-def read_or_refuse(data, options):
+def read_or_refuse(data, options, name=None):
     try:
-        surface = read_bytes(data, options)
+        surface = read_bytes(data, options, name=name)
     except InputError:
         return
     assert_sane(surface)
@@ -56,12 +56,13 @@ def assert_sane(surface):
 
 @pytest.mark.parametrize("name", sorted(SEEDS))
 def test_the_seeds_are_valid(name):
-    assert_sane(read_bytes(SEEDS[name], SPACED))
+    assert_sane(read_bytes(SEEDS[name], SPACED, name=name))
 
 
 @pytest.mark.parametrize("name", sorted(SEEDS))
+@pytest.mark.filterwarnings("error::pytest.PytestUnraisableExceptionWarning")  # a library's traceback on stderr
 @settings(max_examples=400, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
 @given(data=st.data())
 def test_mutated_files_are_read_or_refused(name, data):
     blob = data.draw(mutated(SEEDS[name]))
-    read_or_refuse(blob, SPACED if name.endswith(".npy") else OPTIONS)
+    read_or_refuse(blob, SPACED if name.endswith(".npy") else OPTIONS, name)

@@ -82,6 +82,11 @@ def test_every_hostile_file_is_refused_cleanly(tmp_path):
         "gsf-absurd-size.gsf",
         "npy-absurd-shape.npy",
         "al3d-absurd-size.al3d",
+        "sur-absurd-size.sur",
+        "sur-zlib-bomb.sur",
+        "ibw-note-size.ibw",
+        "gwy-array-past-end.gwy",
+        "hdf5-sparse-bomb.h5",
     ],
 )
 def test_bombs_and_absurd_sizes_are_refused_before_allocation(name):

@@ -467,12 +467,20 @@ class Exploding(QuasiStatic):
         return super().step(*arguments)
 
 
-def test_an_exception_zeroes_the_force_at_once():
-    device = TimedDevice([(5e-3, -1e-3, 0)])
+def test_an_exception_zeroes_the_force_at_once(monkeypatch):
+    """The zero follows the failing step before the loop reads its clock again: no tick
+    passes (ordering against the loop's clock, not wall time, so a busy machine cannot
+    fail it)."""
+    device, model = TimedDevice([(5e-3, -1e-3, 0)]), Exploding(25)
+    clock, readings = time.perf_counter, []
+    monkeypatch.setattr(time, "perf_counter", lambda: readings.append((len(device.written), model.calls)) or clock())
     with pytest.raises(RuntimeError):
-        run(device, [FLAT], Exploding(25), None, Settings(duration=1.0, realtime=True, watchdog=1.0))
+        run(device, [FLAT], model, None, Settings(duration=1.0, realtime=True, watchdog=1.0))
     assert len(device.written) == 26 and device.written[24][1] > 0 and device.written[25] == (0.0, 0.0)
-    assert device.times[25] - device.times[24] < 2e-3  # within two ticks
+    assert (25, 25) in readings  # the failing tick was paced by the clock
+    # between the failure and the zero the clock is read once, for the wall-time total;
+    # waiting for another tick would read it at least three times (start, pace, stamp)
+    assert readings.count((25, 26)) <= 1
 
 
 def test_a_stalled_loop_is_zeroed_within_two_ticks_of_its_watchdog():

@@ -24,6 +24,7 @@ from .. import __version__
 COMMANDS = {
     "info": "rough.cli.info:info",
     "convert": "rough.cli.convert:convert",
+    "formats": "rough.cli.formats:formats",
     "detrend": "rough.cli.detrend:detrend",
     "features": "rough.cli.features:features",
     "synth": "rough.cli.synth:synth",

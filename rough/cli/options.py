@@ -13,8 +13,6 @@ import sys
 
 import click
 
-FORMAT_CHOICES = ("x3p", "exr", "gsf", "tsv", "npy")
-
 
 def plot_option(help):
     """``--plot FILE``; checks that matplotlib (the ``plot`` extra) is installed before
@@ -149,22 +147,33 @@ BAND = FrequencyRangeType()
 
 
 def crop_option(command):
-    """``--crop X0:X1[,Y0:Y1]``: select the evaluation range before anything else
-    happens. The range includes the samples nearest to its ends."""
-
-    @functools.wraps(command)
-    def wrapper(*args, surface, crop, **kwargs):
-        if crop is not None:
-            if crop[1] is not None and surface.is_profile:
-                raise click.BadParameter("a profile has no y range; give X0:X1", param_hint="--crop")
-            surface = surface.crop(*crop)
-        return command(*args, surface=surface, **kwargs)
-
+    """``--crop X0:X1[,Y0:Y1]``: read only this range (the input options pass it to
+    :func:`rough.read`, which reads only that window of a GeoTIFF). The range includes
+    the samples nearest to its ends."""
     return click.option(
         "--crop",
         type=CROP,
-        help="Evaluate only X0:X1 (and Y0:Y1 for maps), e.g. 468um:733um; positions include the origin.",
-    )(wrapper)
+        help="Evaluate only X0:X1 (and Y0:Y1 for maps), e.g. 468um:733um; positions include the origin. "
+        "A GeoTIFF is read only in this window.",
+    )(command)
+
+
+class RegridType(SpacingType):
+    """``SPACING`` or ``SPACING:linear|bandlimited`` → (metres, method)."""
+
+    name = "SPACING[:METHOD]"
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, tuple):
+            return value
+        length, _, method = str(value).partition(":")
+        method = method.strip().lower() or "bandlimited"
+        if method not in ("linear", "bandlimited"):
+            self.fail(f"{value!r}: the method is linear or bandlimited, e.g. 0.5um:linear", param, ctx)
+        spacing = LengthType.convert(self, length, param, ctx)
+        if spacing <= 0:
+            self.fail(f"{value!r}: the spacing must be positive", param, ctx)
+        return spacing, method
 
 
 def input_options(spacing_flag="--spacing", most=1):
@@ -175,7 +184,7 @@ def input_options(spacing_flag="--spacing", most=1):
 
     def decorate(command):
         @functools.wraps(command)
-        def wrapper(*args, input, spacing, unit, ignore_checksums, **kwargs):
+        def wrapper(*args, input, spacing, unit, ignore_checksums, channel, layer, regrid, **kwargs):
             from ..errors import InputError
             from ..io import read
 
@@ -184,7 +193,20 @@ def input_options(spacing_flag="--spacing", most=1):
                 raise click.UsageError(f"give at most {most} inputs, not {len(names)}")
             if "-" in names and sys.stdin is None:
                 raise InputError("<stdin>: standard input is closed")
-            surfaces = [read(name, spacing=spacing, unit=unit, verify=not ignore_checksums) for name in names]
+            crop = kwargs.pop("crop", None)
+            surfaces = [
+                read(
+                    name,
+                    spacing=spacing,
+                    unit=unit,
+                    verify=not ignore_checksums,
+                    channel=channel,
+                    layer=layer,
+                    crop=crop,
+                    regrid=regrid,
+                )
+                for name in names
+            ]
             try:
                 if most > 1:
                     return command(*args, surfaces=surfaces, inputs=list(names), **kwargs)
@@ -213,6 +235,21 @@ def input_options(spacing_flag="--spacing", most=1):
             click.option(
                 "--ignore-checksums", is_flag=True, help="Read X3P files whose MD5 checksums fail, with a warning."
             ),
+            click.option(
+                "--channel",
+                metavar="NAME|N",
+                help="The channel of a multi-channel file (AFM, HDF5, ...), by name or number from 0; "
+                "default the height channel (rough info lists them).",
+            ),
+            click.option(
+                "--layer", type=click.IntRange(0), help="The layer of a multi-layer X3P file, from 0 (default 0)."
+            ),
+            click.option(
+                "--regrid",
+                type=RegridType(),
+                help="Interpolate unevenly spaced data (stylus exports, irregular X3P) onto this spacing, "
+                "e.g. 0.5um (band-limited) or 0.5um:linear; recorded in the history. Without it they are refused.",
+            ),
         ]
         for decorator in reversed(decorators):
             wrapper = decorator(wrapper)
@@ -222,6 +259,20 @@ def input_options(spacing_flag="--spacing", most=1):
 
 
 surface_input = input_options()
+
+
+class _WritableFormats(click.Choice):
+    """The formats rough writes, looked up in the registry when first needed, so that
+    ``rough --help`` starts without importing the readers."""
+
+    def __init__(self):
+        self.case_sensitive = True
+
+    @functools.cached_property
+    def choices(self):
+        from ..io.registry import writable
+
+        return tuple(writable())
 
 
 def surface_output(command):
@@ -235,7 +286,7 @@ def surface_output(command):
     wrapper = click.option(
         "-f",
         "--format",
-        type=click.Choice(FORMAT_CHOICES),
+        type=_WritableFormats(),
         default=None,
         help="Output format (default: from the output file's extension; X3P on standard output).",
     )(wrapper)

@@ -15,13 +15,12 @@ output format follows ``format=`` or the file extension, and a stream gets X3P.
 >>> again.source_format, again.heights.shape
 ('gsf', (96, 128))
 
-Formats (one module each): X3P (ISO 25178-72), OpenEXR, GSF (Gwyddion Simple Field),
-text (TSV/CSV columns, Dektak CSV, Gwyddion text export, x y z grids), NPY, and
-ISO 25178-71 SDF and Alicona AL3D (read only). Gzip-compressed input is unpacked first.
+Formats: one module each, declared in :mod:`rough.io.registry` (``rough formats``
+lists them). Gzip-compressed input is unpacked first.
 """
 
+import contextlib
 import dataclasses
-import importlib
 import io
 import logging
 import os
@@ -35,31 +34,8 @@ import zlib
 import numpy as np
 
 from ..errors import FormatError, InputError
-from . import limits
+from . import limits, registry
 
-FORMATS = {
-    "x3p": "X3P (ISO 25178-72)",
-    "exr": "OpenEXR",
-    "gsf": "Gwyddion Simple Field",
-    "tsv": "text",
-    "npy": "NumPy NPY",
-    "sdf": "ISO 25178-71 SDF",
-    "al3d": "Alicona AL3D",
-}
-WRITABLE = ("x3p", "exr", "gsf", "tsv", "npy")
-BINARY = ("x3p", "exr", "gsf", "npy")
-EXTENSIONS = {".x3p": "x3p", ".exr": "exr", ".gsf": "gsf", ".tsv": "tsv", ".txt": "tsv", ".npy": "npy"}
-_MODULES = {"x3p": "x3p", "exr": "exr", "gsf": "gsf", "tsv": "text", "npy": "npy", "sdf": "sdf", "al3d": "al3d"}
-_MAGIC = (
-    (b"PK\x03\x04", "x3p"),
-    (b"PK\x05\x06", "x3p"),
-    (b"\x76\x2f\x31\x01", "exr"),
-    (b"Gwyddion Simple Field", "gsf"),
-    (b"\x93NUMPY", "npy"),
-    (b"aISO-1.0", "sdf"),
-    (b"bISO-1.0", "sdf"),
-    (b"AliconaImaging\0", "al3d"),
-)
 GZIP_MAGIC = b"\x1f\x8b"
 log = logging.getLogger("rough")
 
@@ -89,14 +65,25 @@ class ReadOptions:
         column of heights); it also overrides a file's own spacing.
     unit: the length unit of text values that name none (default metres).
     verify: check X3P checksums; False reads a file whose checksums fail, with a warning.
+    channel: the channel of a multi-channel file, a name or a number from 0 (default:
+        the height channel).
+    layer: the layer of a multi-layer X3P file, from 0 (default 0).
+    window: ``((x0, x1), (y0, y1) or None)`` in metres, an ``--crop`` range that
+        formats able to read part of a file (GeoTIFF) read alone; None ends are open.
+    regrid: ``(spacing, method)`` for unevenly spaced profiles (see
+        :mod:`rough.io.regrid`); without it they are refused.
     """
 
     spacing: tuple = None
     unit: str = None
     verify: bool = True
+    channel: object = None
+    layer: int = None
+    window: tuple = None
+    regrid: tuple = None
 
 
-def read(source, *, spacing=None, unit=None, verify=True):
+def read(source, *, spacing=None, unit=None, verify=True, channel=None, layer=None, crop=None, regrid=None):
     """Read a surface from a path, ``'-'`` (standard input), a binary stream or bytes.
 
     The format is sniffed from the content, not the name; gzip-compressed data are
@@ -116,6 +103,22 @@ def read(source, *, spacing=None, unit=None, verify=True):
     verify : bool, default True
         Check X3P checksums; False reads a file whose checksums fail or are missing,
         with a warning.
+    channel : str or int, optional
+        The channel of a multi-channel file (AFM files, HDF5, ...): its name (any
+        case) or its number from 0. Default: the height channel. ``rough info``
+        lists a file's channels.
+    layer : int, optional
+        The layer of a multi-layer X3P file, from 0 (default 0).
+    crop : tuple, optional
+        ``((x0, x1), (y0, y1))`` or ``((x0, x1), None)``, metres, None for an open end:
+        read only this range. GeoTIFF reads only that window from disk, so an
+        elevation model larger than memory can be analysed piece by piece; other
+        formats are read whole and cropped.
+    regrid : float or (float, str), optional
+        A spacing in metres, and optionally the method (``"bandlimited"``, the
+        default, or ``"linear"``), for unevenly spaced profiles (stylus exports,
+        x z text): they are interpolated onto that grid and the step is recorded in
+        the history. Without it such data are refused.
 
     Returns
     -------
@@ -156,30 +159,73 @@ def read(source, *, spacing=None, unit=None, verify=True):
     >>> column.spacing, (column.heights * 1e9).round(6).tolist()  # m, nm
     ((0.001,), [100.0, 200.0, 400.0])
     """
-    name, data = _slurp(source)
-    options = ReadOptions(spacing=_spacing_tuple(spacing), unit=unit, verify=verify)
-    try:
-        surface = read_bytes(data, options)
-    except InputError as error:
-        raise type(error)(f"{name}: {error}") from error
+    options = ReadOptions(
+        spacing=_spacing_tuple(spacing),
+        unit=unit,
+        verify=verify,
+        channel=channel,
+        layer=layer,
+        window=_window(crop),
+        regrid=_regrid(regrid),
+    )
+    name = _name(source)
+    with _named(name):
+        surface = _read_path(name, options) if _is_path(source) else None
+    if surface is None:
+        name, data = _slurp(source)
+        with _named(name):
+            surface = read_bytes(data, options, name=name)
     surface.metadata.setdefault("source", name)
     return surface
 
 
-def read_bytes(data, options=ReadOptions()):
-    """Parse a whole file's bytes (sniffing the format) into a Surface. Raises
-    InputError (FormatError for malformed data) and nothing else for bad input."""
+@contextlib.contextmanager
+def _named(name):
+    """Prefix the file's name to the message of an InputError raised inside."""
     try:
-        return _parse(data, options)
+        yield
+    except InputError as error:
+        raise type(error)(f"{name}: {error}") from error
+
+
+def read_bytes(data, options=ReadOptions(), name=None):
+    """Parse a whole file's bytes (sniffing the format; ``name``'s extension decides
+    for formats without a magic number) into a Surface, cropped to ``options.window``.
+    Raises InputError (FormatError for malformed data) and nothing else for bad input."""
+    try:
+        return _parse(data, options, name)
     except MemoryError:
         raise InputError("too large to read into memory") from None
     except RecursionError:
-        raise FormatError(f"malformed {describe(sniff(data))} file (nested too deeply to read)") from None
+        raise FormatError(f"malformed {describe(sniff(data, name))} file (nested too deeply to read)") from None
     except _PARSE_ERRORS as error:
-        raise FormatError(f"malformed {describe(sniff(data))} file ({error})") from error
+        raise FormatError(f"malformed {describe(sniff(data, name))} file ({error})") from error
 
 
-def _parse(data, options):
+def _read_path(path, options):
+    """A surface read straight from disk by a format that reads part of a file
+    (``read_path``), or None for formats read from their bytes."""
+    if not os.path.isfile(path):
+        return None  # _slurp reads devices and pipes, and gives the messages
+    try:
+        with open(path, "rb") as stream:
+            head = stream.read(registry.HEAD)
+        format_module = registry.module_of(sniff(head, path))
+    except (OSError, InputError):
+        return None
+    if not hasattr(format_module, "read_path"):
+        return None
+    try:
+        with np.errstate(all="ignore"):
+            surface = format_module.read_path(path, options)
+    except MemoryError:
+        raise InputError("too large to read into memory") from None
+    except _PARSE_ERRORS as error:
+        raise FormatError(f"malformed {describe(sniff(head, path))} file ({error})") from error
+    return _checked(surface, format_module.FORMAT.name, options, windowed=True)
+
+
+def _parse(data, options, name=None):
     if not data:
         raise FormatError("empty file, no surface to read")
     packed, layers = len(data), 0
@@ -188,7 +234,7 @@ def _parse(data, options):
         if layers > limits.MAX_GZIP_LAYERS:
             raise FormatError(f"gzip nested more than {limits.MAX_GZIP_LAYERS} deep; refusing")
         data = gunzip(data, packed)
-    format_name = sniff(data)
+    format_name = sniff(data, name)
     text_cap = limits.cap("MAX_TEXT_BYTES")
     if format_name == "tsv" and len(data) > text_cap:
         raise FormatError(
@@ -197,6 +243,12 @@ def _parse(data, options):
         )
     with np.errstate(all="ignore"):
         surface = _module(format_name).read(data, options)
+    return _checked(surface, format_name, options)
+
+
+def _checked(surface, format_name, options, windowed=False):
+    """The checks and options every format shares: infinite heights → NaN, at least
+    two points and one valid, ``options.spacing`` and ``options.window``."""
     surface.source_format = format_name
     if not np.isfinite(surface.heights).all():
         infinite = np.isinf(surface.heights)
@@ -214,24 +266,39 @@ def _parse(data, options):
         raise FormatError(f"holds no valid points (all {surface.heights.size} heights are invalid)")
     if options.spacing is not None and surface.spacing != options.spacing:
         surface = dataclasses.replace(surface, spacing=options.spacing[: surface.heights.ndim])
+    if options.window is not None and not windowed:
+        x, y = options.window
+        if y is not None and surface.is_profile:
+            raise InputError("a profile has no y range; crop it with X0:X1")
+        surface = surface.crop(x, y)
     return surface
 
 
-def sniff(data):
-    """The format of a file from its first bytes: a key of FORMATS."""
-    head = bytes(data[:32])
-    for magic, name in _MAGIC:
-        if head.startswith(magic):
-            return name
-    if head.startswith((b"\xff\xfe", b"\xfe\xff")):
-        return "tsv"
-    if b"\0" in bytes(data[:4096]):
-        raise FormatError("not a surface file rough can read (unrecognised binary data)")
-    return "tsv"
+def sniff(data, name=None):
+    """The format of a file from its first bytes (and, for the few formats with no
+    magic number, the extension of ``name``): a key of :data:`FORMATS`."""
+    return registry.sniff(data, name)
 
 
 def describe(format_name):
-    return FORMATS.get(format_name, format_name)
+    """What people call a format (``"Digital Surf SUR"``), from its key."""
+    facts = registry.formats().get(format_name)
+    return facts.title if facts else format_name
+
+
+def __getattr__(attribute):
+    """``FORMATS`` ({key: title}), ``WRITABLE``, ``BINARY`` (written formats that are
+    binary) and ``EXTENSIONS`` ({extension: key} for writing), from the registry."""
+    if attribute not in ("FORMATS", "WRITABLE", "BINARY", "EXTENSIONS"):
+        raise AttributeError(f"module {__name__!r} has no attribute {attribute!r}")
+    table = registry.formats()
+    if attribute == "FORMATS":
+        return {name: facts.title for name, facts in table.items()}
+    if attribute == "WRITABLE":
+        return registry.writable()
+    if attribute == "BINARY":
+        return tuple(name for name in registry.writable() if table[name].binary)
+    return registry.extensions()
 
 
 def write(surface, target, format=None):
@@ -285,7 +352,7 @@ def write(surface, target, format=None):
     if isinstance(target, (str, os.PathLike)) and os.fspath(target) != "-":
         chosen = format or format_for_path(target)
         with atomic_output(target) as stream:
-            _module(chosen).write(surface, stream)
+            _writer(chosen).write(surface, stream)
     else:
         standard_output = getattr(sys.stdout, "buffer", None)  # absent in some notebook kernels
         stream = standard_output if target == "-" else target
@@ -293,16 +360,17 @@ def write(surface, target, format=None):
             raise InputError("standard output takes no binary data here; write to a file or a binary stream")
         if stream is standard_output:
             widen_pipe(sys.stdout)
-        _module(format or "x3p").write(surface, stream)
+        _writer(format or "x3p").write(surface, stream)
 
 
 def format_for_path(path):
     """The output format implied by a file name's extension."""
     extension = os.path.splitext(os.fspath(path))[1].lower()
-    if extension not in EXTENSIONS:
-        known = ", ".join(sorted(EXTENSIONS))
+    table = registry.extensions()
+    if extension not in table:
+        known = ", ".join(sorted(table))
         raise InputError(f"{path}: cannot tell the format from the extension (use {known}, or -f FORMAT)")
-    return EXTENSIONS[extension]
+    return table[extension]
 
 
 def gunzip(data, packed=None):
@@ -329,9 +397,19 @@ def gunzip(data, packed=None):
 
 
 def _module(format_name):
-    if format_name not in _MODULES:
-        raise InputError(f"unknown format {format_name!r} (use one of {', '.join(WRITABLE)})")
-    return importlib.import_module(f"{__name__}.{_MODULES[format_name]}")
+    try:
+        return registry.module_of(format_name)
+    except KeyError:
+        raise InputError(f"unknown format {format_name!r} (use one of {', '.join(registry.writable())})") from None
+
+
+def _writer(format_name):
+    format_module = _module(format_name)
+    if not hasattr(format_module, "write"):
+        raise InputError(
+            f"rough reads {describe(format_name)} but does not write it (write one of {', '.join(registry.writable())})"
+        )
+    return format_module
 
 
 def _slurp(source):
@@ -371,6 +449,36 @@ def widen_pipe(stream, size=1 << 20):
             fcntl.fcntl(stream.fileno(), getattr(fcntl, "F_SETPIPE_SZ", 1031), size)
     except (OSError, ValueError, AttributeError, ImportError):
         pass
+
+
+def _is_path(source):
+    return isinstance(source, (str, os.PathLike)) and os.fspath(source) != "-"
+
+
+def _name(source):
+    if _is_path(source):
+        return os.fspath(source)
+    if source == "-" or source is sys.stdin:
+        return "<stdin>"
+    if isinstance(source, (bytes, bytearray, memoryview)):
+        return "<bytes>"
+    return getattr(source, "name", "<stream>")
+
+
+def _window(crop):
+    if crop is None:
+        return None
+    x, y = (tuple(crop) + (None,))[:2]
+    return (tuple(x) if x is not None else (None, None)), (tuple(y) if y is not None else None)
+
+
+def _regrid(regrid):
+    if regrid is None:
+        return None
+    spacing, method = regrid if isinstance(regrid, (tuple, list)) else (regrid, "bandlimited")
+    if not float(spacing) > 0:
+        raise InputError(f"the regrid spacing must be a positive length, got {spacing!r}")
+    return float(spacing), method
 
 
 def _spacing_tuple(spacing):

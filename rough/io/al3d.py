@@ -13,6 +13,11 @@ import numpy as np
 
 from ..errors import FormatError
 from ..surface import Surface
+from .registry import Format
+
+FORMAT = Format(
+    "al3d", "Alicona AL3D", (".al3d",), magic=(b"AliconaImaging\0",), carries=("spacing", "metadata", "mask")
+)
 
 MAGIC = b"AliconaImaging\0\r\n"
 TAG_SIZE, KEY_SIZE, VALUE_SIZE = 52, 20, 30

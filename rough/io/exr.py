@@ -26,6 +26,16 @@ from ..errors import FormatError
 from ..surface import Surface, Units
 from ..units import metres_per
 from . import limits, provenance
+from .registry import Format
+
+FORMAT = Format(
+    "exr",
+    "OpenEXR",
+    (".exr",),
+    magic=(b"\x76\x2f\x31\x01",),
+    writes=True,
+    carries=("spacing", "units", "metadata", "history"),
+)
 
 HEIGHT_CHANNELS = ("Y", "Z", "R")
 MAX_POINTS = 1 << 31

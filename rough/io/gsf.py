@@ -17,6 +17,16 @@ from ..errors import FormatError
 from ..surface import Surface, Units
 from ..units import metres_per
 from . import provenance
+from .registry import Format
+
+FORMAT = Format(
+    "gsf",
+    "Gwyddion Simple Field",
+    (".gsf",),
+    magic=(b"Gwyddion Simple Field",),
+    writes=True,
+    carries=("spacing", "units", "metadata", "mask", "history"),
+)
 
 MAGIC = b"Gwyddion Simple Field 1.0"
 MAX_HEADER_BYTES = 1 << 20

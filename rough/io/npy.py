@@ -10,6 +10,9 @@ import numpy as np
 
 from ..errors import FormatError
 from ..surface import Surface
+from .registry import Format
+
+FORMAT = Format("npy", "NumPy NPY", (".npy",), magic=(b"\x93NUMPY",), writes=True)
 
 
 def read(data, options):

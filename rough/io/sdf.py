@@ -16,6 +16,15 @@ import numpy as np
 from ..errors import FormatError
 from ..surface import Surface
 from . import limits
+from .registry import Format
+
+FORMAT = Format(
+    "sdf",
+    "ISO 25178-71 SDF",
+    (".sdf",),
+    magic=(b"aISO-1.0", b"bISO-1.0"),
+    carries=("spacing", "metadata", "time", "mask"),
+)
 
 BINARY_HEADER = struct.Struct("<8s10s12s12sHHddddBBB")
 DATA_TYPES = ("<u1", "<u2", "<u4", "<f4", "<i1", "<i2", "<i4", "<f8")

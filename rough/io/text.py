@@ -1,20 +1,33 @@
 """Text surfaces: read in several dialects, written as TSV.
 
 Read (the dialect is recognised from the content):
-    columns     ``z`` alone (needs ``--spacing``), ``x z``, ``x z valid`` or ``x y z``
-                (an x y z grid, points in any order, missing points NaN), separated by
-                spaces, tabs, commas or semicolons (then a decimal comma is accepted);
-                an optional line of column names, whose units (``x[um]``, ``z (nm)``,
-                ``Lateral um``) or a following line of units (``[mm];[mm];[1/0]``) say
-                the unit; a ``# unit: mm`` line gives it for all columns. Four or more
-                columns are a plain matrix of heights (rows are y; needs ``--spacing``).
-    Dektak      the Bruker Dektak CSV export (``Scan Parameters`` … ``Scan Data``).
-    Gwyddion    Gwyddion's text export (``# Width:``, ``# Height:``, ``# Value units:``).
-    key=value   a matrix after ``h=… w=…``, ``pixel size=…``, ``height conversion factor``.
-Units: named in the file, else ``unit`` (``--unit``), else metres. x values must be
-evenly spaced to within their printed precision (Dektak prints 0.1 µm steps for a
-0.15625 µm spacing); the spacing is their least-squares slope. Unevenly spaced x is
-refused rather than silently resampled. ``nan`` and ``BAD`` mark invalid points.
+
+columns
+    ``z`` alone (needs ``--spacing``), ``x z``, ``x z valid`` or ``x y z`` (an x y z
+    grid, points in any order, missing points NaN), separated by spaces, tabs, commas
+    or semicolons (then a decimal comma is accepted); an optional line of column
+    names, whose units (``x[um]``, ``z (nm)``, ``x in µm``, or a bare unit such as
+    ``µm µm``) or a following line of units (``[mm];[mm];[1/0]``) say the unit; a
+    ``# unit: mm`` line gives it for all columns. A first column named ``index`` (or
+    ``#``, ``no``, ``n``) that counts the rows is dropped; a line holding one whole
+    number between the names and the rows (a point count) is skipped. Four or more
+    columns are a plain matrix of heights (rows are y; needs ``--spacing``). UTF-8,
+    UTF-16 with a byte-order mark, or Latin-1.
+Dektak
+    the Bruker Dektak CSV export (``Scan Parameters`` … ``Scan Data``).
+Gwyddion
+    Gwyddion's text export (``# Width:``, ``# Height:``, ``# Value units:``,
+    ``# Channel:``), also with German keywords (``Breite``, ``Höhe``, ``Kanal``).
+key=value
+    a matrix after ``h=… w=…``, ``pixel size=…``, ``height conversion factor``.
+
+Units: named in the file, else ``unit`` (``--unit``), else metres. x values count as
+evenly spaced when they are within their printed precision of a line (Dektak prints
+0.1 µm steps for a 0.15625 µm spacing; a bare ``0`` counts as printed as finely as
+the other values; x printed coarser than a tenth of a step needs at least ten points
+to count); the spacing is their least-squares slope. Profiles with unevenly
+spaced x go through :func:`rough.io.regrid.profile_from_points`: gridded on request
+(``--regrid``), refused otherwise. ``nan`` and ``BAD`` mark invalid points.
 
 Written (TSV): ``#`` lines with the unit, spacing, origin, units, metadata and one line
 per history entry, then ``x z`` (profiles) or ``x y z`` (maps, a blank line between
@@ -32,7 +45,23 @@ from .. import __version__
 from ..errors import FormatError, InputError
 from ..surface import Surface, Units
 from ..units import metres_per
-from . import provenance
+from . import provenance, regrid
+from .registry import Format
+
+
+def _looks_like_text(head):
+    return head.startswith((b"\xff\xfe", b"\xfe\xff")) or b"\0" not in head[:4096]
+
+
+FORMAT = Format(
+    "tsv",
+    "text",
+    (".tsv", ".txt"),
+    probe=_looks_like_text,
+    writes=True,
+    carries=("spacing", "units", "metadata", "mask", "history"),
+    binary=False,
+)
 
 _UNIT_IN_NAME = re.compile(r"[\[(]\s*([^\])]+?)\s*[\])]|\s([A-Za-zµμÅ]+)\s*$")
 _NUMERIC = re.compile(r"^[\s,;]*[+-]?(\d|\.\d|nan|inf|bad)", re.IGNORECASE)
@@ -40,6 +69,9 @@ _BAD = re.compile(r"\bBAD\b", re.IGNORECASE)
 _NUMBER = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$")
 _MISTYPED_NUMBER = re.compile(r"^[+-]?[\dOoIl]*[\d.][\dOoIl.]*([eE][+-]?\d+)?$")
 _INFINITY = re.compile(r"^[+-]?inf(inity)?$", re.IGNORECASE)
+_COUNT = re.compile(r"^\s*\d+\s*$")
+_INDEX_NAMES = ("index", "idx", "#", "no", "no.", "nr", "n", "point")
+_GWYDDION_KEYS = {"kanal": "channel", "breite": "width", "höhe": "height"}  # German export
 
 
 class _BadLine(FormatError):
@@ -71,7 +103,7 @@ def _line_number(raw, line):
 def _read_lines(lines, options):
     if any(line.strip() == "Scan Data" for line in lines[:200]):
         return _dektak(lines, options)
-    if any(line.startswith("# Width:") for line in lines[:20]):
+    if any(line.startswith(("# Width:", "# Breite:")) for line in lines[:20]):
         return _gwyddion_export(lines)
     if "=" in lines[0] and not _NUMERIC.match(lines[0]):
         return _key_value_matrix(lines, options)
@@ -122,10 +154,14 @@ def _columns(lines, options):
     settings = _comment_settings(comments)
     body = [line for line in lines if not line.lstrip().startswith(("#", "%"))]
     names, units_row, body = _column_names(body)
+    if len(body) > 1 and _COUNT.match(body[0]) and len(_split(body[1], _delimiter(body[1]))) > 1:
+        body = body[1:]
     if not body:
         raise FormatError("no numeric data found")
     delimiter = _delimiter(body[0])
     table = _numbers(body, delimiter, None)
+    first = 1 if table.shape[1] >= 3 and _counts_rows(names, table[:, 0]) else 0
+    table, names, units_row = table[:, first:], names[first:], units_row and units_row[first:]
     count = table.shape[1]
     default_unit = settings.get("unit") or options.unit or "m"
     units = [_unit_of(name, default_unit) for name in (units_row or names or [""] * count)]
@@ -135,13 +171,15 @@ def _columns(lines, options):
         flag = next(i for i, n in enumerate(lower) if "valid" in n or "mask" in n)
         keep = [i for i in range(count) if i != flag][:2]
         heights = np.where(table[:, flag] != 0, table[:, keep[1]], np.nan)
-        return _profile(table[:, keep[0]], heights, units[keep[0]], units[keep[1]], settings, body, delimiter)
+        x_tokens = _column_tokens(body, delimiter, first + keep[0])
+        return _profile(table[:, keep[0]], heights, (units[keep[0]], units[keep[1]]), settings, options, x_tokens)
     if count == 1:
         return _from_spacing(table[:, 0] * metres_per(units[0]), options, settings, Units(units[0], units[0]))
     if count == 2:
-        return _profile(table[:, 0], table[:, 1], units[0], units[1], settings, body, delimiter)
+        x_tokens = _column_tokens(body, delimiter, first)
+        return _profile(table[:, 0], table[:, 1], units[:2], settings, options, x_tokens)
     if count == 3:
-        return _grid(table, units, settings, body, delimiter)
+        return _grid(table, units, settings)
     heights = table * metres_per(default_unit)
     return _from_spacing(
         heights if len(heights) > 1 else heights[0], options, settings, Units(default_unit, default_unit)
@@ -165,7 +203,7 @@ def _dektak(lines, options):
     for key in ("Stylus", "Length", "Resolution", "Force", "Scan Type", "Profile", "Duration"):
         if key in parameters:
             metadata[f"dektak_{key.lower().replace(' ', '_')}"] = parameters[key]
-    surface = _profile(table[:, 0], table[:, 1], x_unit, z_unit, {}, body, ",")
+    surface = _profile(table[:, 0], table[:, 1], (x_unit, z_unit), {}, options, _column_tokens(body, ",", 0))
     surface.metadata.update(metadata)
     return surface
 
@@ -176,7 +214,8 @@ def _gwyddion_export(lines):
         if line.startswith("#"):
             key, colon, value = line[1:].partition(":")
             if colon:
-                header[key.strip().lower()] = value.strip()
+                key = key.strip().lower()
+                header[_GWYDDION_KEYS.get(key, key)] = value.strip()
     body = [line for line in lines if not line.startswith("#")]
     table = _numbers(body, None, None)
     z_unit = header.get("value units", "m")
@@ -324,16 +363,24 @@ def _numbers(body, delimiter, columns):
 
 
 def _unit_of(name, default):
-    """The length unit named in a column name such as ``x[um]``, ``z (nm)`` or ``Lateral um``."""
+    """The length unit named in a column name such as ``x[um]``, ``z (nm)``, ``Lateral um``
+    or ``µm`` alone."""
     match = _UNIT_IN_NAME.search(name or "")
-    if match:
-        candidate = match.group(1) or match.group(2)
+    for candidate in (match and (match.group(1) or match.group(2)), (name or "").strip()):
         try:
-            metres_per(candidate)
-            return candidate
+            if candidate:
+                metres_per(candidate)
+                return candidate
         except InputError:
             pass
     return default
+
+
+def _counts_rows(names, values):
+    """Whether the first column is a row index: named like one and counting 0, 1, 2, …
+    (or from 1)."""
+    named = bool(names) and names[0].strip().lower() in _INDEX_NAMES
+    return named and bool(np.all(values == values[0] + np.arange(len(values)))) and values[0] in (0, 1)
 
 
 def _length_with_unit(text, what):
@@ -349,18 +396,24 @@ def _length_with_unit(text, what):
 
 def _quanta(tokens):
     """How finely each printed number resolves its value: ``'1.25'`` → 0.01,
-    ``'3e-05'`` → 1e-05, ``'7'`` → 1."""
-    quanta = []
+    ``'3e-05'`` → 1e-05, ``'7'`` → 1. A zero (often printed bare, ``0``, among
+    ``1.6655563e-08``) is taken as printed as finely as the median other value."""
+    quanta, zero = [], []
     for token in tokens:
         mantissa, _, exponent = token.strip().lower().partition("e")
         quanta.append(10.0 ** (int(exponent or 0) - len(mantissa.partition(".")[2])))
-    return np.array(quanta)
+        zero.append(not mantissa.strip("+-0."))
+    quanta, zero = np.array(quanta), np.array(zero, bool)
+    if zero.any() and not zero.all():
+        quanta[zero] = np.median(quanta[~zero])
+    return quanta
 
 
 def _regular(values, tokens, what):
-    """``(step, start)`` of evenly spaced values by least squares. Values must lie on
-    the line exactly, or within the rounding of the digits they were printed with
-    (``tokens``, a callable giving the printed text of each value, is asked only then)."""
+    """``(step, start)`` of evenly spaced values by least squares, or None when they are
+    not. Values must lie on the line exactly, or within the rounding of the digits they
+    were printed with (``tokens``, a callable giving the printed text of each value, is
+    asked only then); values printed coarser than a tenth of a step need ten of them."""
     n = len(values)
     if n < 2:
         raise FormatError(f"a single {what} value gives no spacing")
@@ -369,13 +422,12 @@ def _regular(values, tokens, what):
     deviation = np.abs(values - (start + step * index))
     if step > 0 and deviation.max() <= 1e-9 * step * n:
         return float(step), float(start)
-    rounding = 0.6 * _quanta(tokens()) if step > 0 else np.inf
-    if not (step > 0 and np.all(deviation <= rounding) and rounding.max() < 0.5 * step):
-        steps = np.diff(values)
-        raise FormatError(
-            f"{what} values are not evenly spaced (steps from {steps.min():.6g} to {steps.max():.6g}); "
-            "rough needs a regular grid, so resample them first"
-        )
+    if not step > 0:
+        return None
+    quanta = _quanta(tokens())
+    convincing = n >= 10 or quanta.max() <= 0.1 * step  # a few coarsely printed values prove nothing
+    if not (convincing and np.all(deviation <= 0.6 * quanta) and 0.6 * quanta.max() < 0.5 * step):
+        return None
     return float(step), float(start)
 
 
@@ -388,21 +440,29 @@ def _column_tokens(body, delimiter, column):
     return lambda: [_split(line, delimiter)[column] for line in body]
 
 
-def _profile(x, z, x_unit, z_unit, settings, body, delimiter):
+def _profile(x, z, units, settings, options, x_tokens):
+    """A profile from x and z columns (``units`` their units, ``x_tokens`` a callable
+    giving x as printed); unevenly spaced x goes to :func:`regrid.profile_from_points`."""
     if len(x) < 2:
         raise FormatError("a profile needs at least two points to have a spacing")
+    tokens = x_tokens
     if x[-1] < x[0]:
-        x, z = x[::-1], z[::-1]
-    x_factor, z_factor = metres_per(x_unit), metres_per(z_unit)
+        x, z, tokens = x[::-1], z[::-1], lambda: x_tokens()[::-1]
+    x_factor, z_factor = metres_per(units[0]), metres_per(units[1])
+    metadata, surface_units, history = _provenance(settings, Units(*units))
     if "spacing" in settings:
-        step, start = _floats(settings["spacing"])[0] / x_factor, x[0]
+        regular = _floats(settings["spacing"])[0] / x_factor, x[0]
     else:
-        step, start = _regular(x, _column_tokens(body, delimiter, 0), "x")
-    metadata, units, history = _provenance(settings, Units(x_unit, z_unit))
-    return Surface(z * z_factor, (step * x_factor,), (start * x_factor,), units, metadata, history)
+        regular = _regular(x, tokens, "x") if np.isfinite(x).all() else None
+    if regular is None:
+        return regrid.profile_from_points(
+            x * x_factor, z * z_factor, options, units=surface_units, metadata=metadata, history=history
+        )
+    step, start = regular
+    return Surface(z * z_factor, (step * x_factor,), (start * x_factor,), surface_units, metadata, history)
 
 
-def _grid(table, units, settings, body, delimiter):
+def _grid(table, units, settings):
     x, y, z = table.T
     factors = [metres_per(u) for u in units[:3]]
     given = _floats(settings["spacing"]) if "spacing" in settings else None
@@ -412,7 +472,14 @@ def _grid(table, units, settings, body, delimiter):
         if given:
             step, start = given[column] / factors[column], levels[0]
         else:
-            step, start = _regular(levels, _level_tokens(levels), "xy"[column]) if len(levels) > 1 else (1.0, levels[0])
+            regular = _regular(levels, _level_tokens(levels), "xy"[column]) if len(levels) > 1 else (1.0, levels[0])
+            if regular is None:
+                steps = np.diff(levels)
+                raise FormatError(
+                    f"irregular grid: {'xy'[column]} values are not evenly spaced (steps from {steps.min():.6g} "
+                    f"to {steps.max():.6g}); rough needs a regular grid, so resample them first"
+                )
+            step, start = regular
         index = np.rint((values - start) / step)
         if np.max(np.abs(values - (start + index * step))) > 0.25 * step:
             raise FormatError(f"irregular grid: {'xy'[column]} values do not fall on a regular grid")

