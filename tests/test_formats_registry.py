@@ -205,6 +205,18 @@ def test_the_docs_list_every_format():
         assert f"``{name}``" in page, name
 
 
+@pytest.mark.parametrize(
+    "value, fragment",
+    [(0.0, "positive length"), (-1e-6, "positive length"), ("abc", "positive length"), ((1e-6, "cubic"), "cubic")],
+)
+def test_a_bad_regrid_option_is_refused_whatever_the_format(value, fragment):
+    """Checked once, where the read options are made, for every reader that regrids."""
+    with pytest.raises(InputError, match=fragment):
+        ReadOptions(regrid=value)
+    with pytest.raises(InputError, match=fragment):
+        read(b"x z\n0 0\n1 1\n3 3\n", regrid=value)
+
+
 def test_the_cli_regrid_option_takes_a_length_and_a_method(run):
     uneven = b"x z\n0 0\n1 1\n3 3\n4 4\n"
     facts = json.loads(run("info", "--json", "--regrid", "0.5m:linear", input=uneven, check=True).stdout)

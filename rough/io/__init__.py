@@ -35,6 +35,7 @@ import numpy as np
 
 from ..errors import FormatError, InputError
 from . import limits, registry
+from .regrid import option as regrid_option
 
 GZIP_MAGIC = b"\x1f\x8b"
 log = logging.getLogger("rough")
@@ -81,6 +82,10 @@ class ReadOptions:
     layer: int = None
     window: tuple = None
     regrid: tuple = None
+
+    def __post_init__(self):
+        if self.regrid is not None:
+            object.__setattr__(self, "regrid", regrid_option(self.regrid))
 
 
 def read(source, *, spacing=None, unit=None, verify=True, channel=None, layer=None, crop=None, regrid=None):
@@ -166,7 +171,7 @@ def read(source, *, spacing=None, unit=None, verify=True, channel=None, layer=No
         channel=channel,
         layer=layer,
         window=_window(crop),
-        regrid=_regrid(regrid),
+        regrid=regrid,
     )
     name = _name(source)
     with _named(name):
@@ -192,14 +197,22 @@ def read_bytes(data, options=ReadOptions(), name=None):
     """Parse a whole file's bytes (sniffing the format; ``name``'s extension decides
     for formats without a magic number) into a Surface, cropped to ``options.window``.
     Raises InputError (FormatError for malformed data) and nothing else for bad input."""
-    try:
+    with _malformed(lambda: describe(sniff(data, name))):
         return _parse(data, options, name)
+
+
+@contextlib.contextmanager
+def _malformed(title):
+    """What a parser raises on a damaged file, as one InputError: FormatError naming
+    the format (``title()`` gives its name, asked only then), or "too large"."""
+    try:
+        yield
     except MemoryError:
         raise InputError("too large to read into memory") from None
     except RecursionError:
-        raise FormatError(f"malformed {describe(sniff(data, name))} file (nested too deeply to read)") from None
+        raise FormatError(f"malformed {title()} file (nested too deeply to read)") from None
     except _PARSE_ERRORS as error:
-        raise FormatError(f"malformed {describe(sniff(data, name))} file ({error})") from error
+        raise FormatError(f"malformed {title()} file ({error})") from error
 
 
 def _read_path(path, options):
@@ -215,13 +228,8 @@ def _read_path(path, options):
         return None
     if not hasattr(format_module, "read_path"):
         return None
-    try:
-        with np.errstate(all="ignore"):
-            surface = format_module.read_path(path, options)
-    except MemoryError:
-        raise InputError("too large to read into memory") from None
-    except _PARSE_ERRORS as error:
-        raise FormatError(f"malformed {describe(sniff(head, path))} file ({error})") from error
+    with _malformed(lambda: format_module.FORMAT.title), np.errstate(all="ignore"):
+        surface = format_module.read_path(path, options)
     return _checked(surface, format_module.FORMAT.name, options, windowed=True)
 
 
@@ -470,15 +478,6 @@ def _window(crop):
         return None
     x, y = (tuple(crop) + (None,))[:2]
     return (tuple(x) if x is not None else (None, None)), (tuple(y) if y is not None else None)
-
-
-def _regrid(regrid):
-    if regrid is None:
-        return None
-    spacing, method = regrid if isinstance(regrid, (tuple, list)) else (regrid, "bandlimited")
-    if not float(spacing) > 0:
-        raise InputError(f"the regrid spacing must be a positive length, got {spacing!r}")
-    return float(spacing), method
 
 
 def _spacing_tuple(spacing):

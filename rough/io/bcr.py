@@ -14,10 +14,9 @@ not done here.
 
 import numpy as np
 
-from ..errors import FormatError, InputError
+from ..errors import FormatError
 from ..surface import Surface, Units, check_size
-from ..units import metres_per
-from .header import header_number
+from .header import header_count, header_number, length_unit
 from .registry import Format
 
 FORMAT = Format(
@@ -41,7 +40,7 @@ def read(data, options):
     if kind not in ("bcrstm", "bcrf", "bcrstm_unicode", "bcrf_unicode"):
         raise FormatError(f"BCR fileformat {kind!r} is not bcrstm or bcrf")
     floats = kind.startswith("bcrf")
-    nx, ny = _count(fields, "xpixels"), _count(fields, "ypixels")
+    nx, ny = header_count(fields, "xpixels", "BCR"), header_count(fields, "ypixels", "BCR")
     check_size((ny, nx), "the BCR image")
     order = "<" if _number(fields, "intelmode", 1) else ">"
     dtype = np.dtype(f"{order}f4" if floats else f"{order}i2")
@@ -50,7 +49,7 @@ def read(data, options):
     raw = np.ndarray((ny, nx), dtype, data, start).astype(np.float64)
     invalid = raw > FLOAT_VOID if floats else raw == INT_VOID
     xy_unit, z_unit = fields.get("xunit", "nm"), fields.get("zunit", "nm")
-    lateral, vertical = _metres(xy_unit, "xunit"), _metres(z_unit, "zunit")
+    lateral, vertical = length_unit(xy_unit, "BCR xunit"), length_unit(z_unit, "BCR zunit")
     if fields.get("yunit", xy_unit) != xy_unit:
         raise FormatError(f"BCR xunit {xy_unit!r} and yunit {fields['yunit']!r} differ")
     scale = vertical if floats else vertical * _number(fields, "bit2nm", 1)
@@ -89,17 +88,3 @@ def _fields(text):
 
 def _number(fields, key, default=None):
     return header_number(fields, key, "BCR", default)
-
-
-def _count(fields, key):
-    value = _number(fields, key)
-    if value != int(value) or value < 1:
-        raise FormatError(f"BCR header {key} is {fields[key]!r}, not a positive count")
-    return int(value)
-
-
-def _metres(unit, key):
-    try:
-        return metres_per(unit)
-    except InputError:
-        raise FormatError(f"BCR {key} {unit!r} is not a length unit") from None

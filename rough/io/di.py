@@ -26,7 +26,7 @@ import numpy as np
 
 from ..errors import FormatError
 from ..surface import Surface, Units, check_size
-from .header import metres_or_none
+from .header import length_unit, metres_or_none
 from .registry import Format, channel_list, channel_metadata, choose_channel
 
 FORMAT = Format(
@@ -151,7 +151,7 @@ def _scan_size(fields, name):
     if not numbers or len(parts) != 1 or not all(0 < number < np.inf for number in numbers):
         raise FormatError(f"Nanoscope image {name!r} has no readable Scan Size ({fields.get('Scan Size')!r})")
     unit = _unit(parts[0])
-    factor = _metres(unit, f"Nanoscope Scan Size unit of {name!r}")
+    factor = length_unit(unit, f"Nanoscope Scan Size unit of {name!r}")
     return (numbers[0] * factor, numbers[-1] * factor), unit
 
 
@@ -208,13 +208,6 @@ def _date(text):
 
 def _unit(text):
     return text.strip().replace("~", "µ").replace("\xb5", "µ")
-
-
-def _metres(unit, what):
-    metres = metres_or_none(unit)
-    if metres is None:
-        raise FormatError(f"{what} is {unit!r}, not a length unit")
-    return metres
 
 
 def _is_number(text):

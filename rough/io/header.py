@@ -46,6 +46,22 @@ def header_number(fields, key, what, default=None):
     return value
 
 
+def header_count(fields, key, what):
+    """The positive whole number ``fields[key]``; FormatError naming ``what`` header otherwise."""
+    value = header_number(fields, key, what)
+    if value != int(value) or value < 1:
+        raise FormatError(f"{what} header {key} is {fields[key]!r}, not a positive count")
+    return int(value)
+
+
+def length_unit(unit, what):
+    """Metres per ``unit``; FormatError saying that ``what`` is not a length unit otherwise."""
+    metres = metres_or_none(unit)
+    if metres is None:
+        raise FormatError(f"{what} is {unit!r}, not a length unit")
+    return metres
+
+
 def metres_or_none(unit):
     """Metres per ``unit``, or None when it is not a length unit (V, deg, a.u.)."""
     try:

@@ -20,7 +20,7 @@ import numpy as np
 
 from ..errors import FormatError
 from ..surface import Surface, Units, check_size
-from .header import header_number, metres_or_none
+from .header import header_count, header_number, metres_or_none
 from .registry import Format, channel_list, channel_metadata, choose_channel
 
 FORMAT = Format(
@@ -38,7 +38,7 @@ TYPES = {"BINARY": "<i2", "BINARY_32": "<i4"}
 def read(data, options):
     data = bytes(data)
     fields, channels, start, encoding = _header(data)
-    nx, ny = _count(fields, "xPixels"), _count(fields, "yPixels")
+    nx, ny = header_count(fields, "xPixels", "MI"), header_count(fields, "yPixels", "MI")
     check_size((ny, nx), "the MI image")
     dtype = np.dtype(TYPES[encoding])
     block = nx * ny * dtype.itemsize
@@ -111,10 +111,3 @@ def _date(text):
 
 def _number(fields, key):
     return header_number(fields, key, "MI")
-
-
-def _count(fields, key):
-    value = _number(fields, key)
-    if value != int(value) or value < 1:
-        raise FormatError(f"MI header {key} is {fields[key]!r}, not a positive count")
-    return int(value)

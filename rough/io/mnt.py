@@ -38,11 +38,11 @@ import zlib
 
 import numpy as np
 
-from ..errors import FormatError, InputError
+from ..errors import FormatError
 from ..extras import require
 from ..surface import Surface, Units, check_size
-from ..units import metres_per
 from . import limits
+from .header import length_unit
 from .registry import Format
 
 FORMAT = Format(
@@ -176,7 +176,10 @@ def _axis(data, axes, name):
     if name != "Z" and not count:
         raise FormatError(f"MNT {name} axis gives no point count")
     facts = {"step": step, "offset": offset, "count": count, "unit": unit, "display_unit": display_unit}
-    return facts | {"factor": _factor(unit, name), "display_factor": _factor(display_unit, name)}
+    return facts | {
+        "factor": length_unit(unit, f"MNT {name} unit"),
+        "display_factor": length_unit(display_unit, f"MNT {name} unit"),
+    }
 
 
 def _double(data, entry):
@@ -196,13 +199,6 @@ def _text(data, entry):
     if raw[:1] != b"\x04" or len(raw) % 2 != 1:
         return None
     return raw[1:].decode("utf-16-le", "replace")
-
-
-def _factor(unit, what):
-    try:
-        return metres_per(unit)
-    except InputError:
-        raise FormatError(f"MNT {what} unit {unit!r} is not a length unit") from None
 
 
 def _array(data, payload, count, size):

@@ -20,7 +20,7 @@ import numpy as np
 from ..errors import FormatError
 from ..surface import Surface, Units, check_size
 from ..units import metres_per
-from .header import header_number, ini_sections, metres_or_none
+from .header import header_count, header_number, ini_sections, length_unit, metres_or_none
 from .registry import Format, channel_metadata, choose_channel
 
 FORMAT = Format(
@@ -54,7 +54,7 @@ def read(data, options):
     metres = metres_per(z_unit)
     heights = (_number(fields, "Dim2Min", 0.0) + _number(fields, "Dim2Range") * fraction) * metres
     xy_unit = fields.get("Dim0Unit", "m")
-    lateral = _metres(xy_unit, "Dim0Unit")
+    lateral = length_unit(xy_unit, "NID Dim0Unit")
     spacing = (_number(fields, "Dim0Range") * lateral / nx, _number(fields, "Dim1Range") * lateral / ny)
     metadata = {"vendor": "Nanosurf", **_metadata(sections), **channel_metadata(names, index)}
     return Surface(heights, spacing, units=Units(xy=xy_unit, z=z_unit), metadata=metadata)
@@ -83,7 +83,7 @@ def _channels(sections, start, file_size):
             end = offset + nx * ny * dtype.itemsize
             if end > file_size:
                 raise FormatError(f"NID data set {section!r} ends at byte {end} but the file holds {file_size} bytes")
-            if _is_length(fields.get("Dim2Unit", "")):
+            if metres_or_none(fields.get("Dim2Unit", "")) is not None:
                 name = f"{fields.get('Frame', section)} ({fields.get('Dim2Name', '')})"
                 channels.append({"name": name, "nx": nx, "ny": ny, "dtype": dtype, "offset": offset, "fields": fields})
             offset = end
@@ -97,7 +97,10 @@ def _group_count(listing):
 def _layout(fields, section):
     if fields.get("SaveMode", "Binary") != "Binary":
         raise FormatError(f"NID data set {section!r} is saved as {fields['SaveMode']!r}; rough reads Binary")
-    nx, ny = _count(fields, "Points", section), _count(fields, "Lines", section)
+    nx, ny = (
+        header_count(fields, "Points", f"NID data set {section!r}"),
+        header_count(fields, "Lines", f"NID data set {section!r}"),
+    )
     check_size((ny, nx), f"NID data set {section!r}")
     bits = int(_number(fields, "SaveBits", 32))
     if bits not in (8, 16, 32):
@@ -120,22 +123,5 @@ def _metadata(sections):
     return metadata
 
 
-def _is_length(unit):
-    return metres_or_none(unit) is not None
-
-
-def _metres(unit, key):
-    if not _is_length(unit):
-        raise FormatError(f"NID {key} {unit!r} is not a length unit")
-    return metres_per(unit)
-
-
 def _number(fields, key, default=None):
     return header_number(fields, key, "NID", default)
-
-
-def _count(fields, key, section):
-    value = _number(fields, key)
-    if value != int(value) or value < 1:
-        raise FormatError(f"NID data set {section!r}: {key} is {fields[key]!r}, not a positive count")
-    return int(value)

@@ -30,9 +30,9 @@ import struct
 
 import numpy as np
 
-from ..errors import FormatError, InputError
+from ..errors import FormatError
 from ..surface import Surface, Units, check_size
-from ..units import metres_per
+from .header import length_unit
 from .registry import Format, channel_metadata, choose_channel
 from .regrid import profile_from_points
 
@@ -222,7 +222,7 @@ def _doubles(items, path, count):
 def _scale(items, path):
     """A length quantity in metres."""
     value, symbol = _quantity(items, path)
-    metres = value * _metres_per(symbol, path)
+    metres = value * length_unit(symbol, f"OPDx {path!r} unit")
     if not (np.isfinite(metres) and metres > 0):
         raise FormatError(f"OPDx {path!r} is {value!r} {symbol!r}, not a positive length")
     return metres
@@ -243,14 +243,7 @@ def _unit_scale(payload):
     """Metres per unit of a unit item (name, symbol, float64, 12 bytes)."""
     _, position = _name(payload, 0, len(payload))
     symbol, _ = _name(payload, position, len(payload))
-    return _metres_per(symbol, "PositionUnits")
-
-
-def _metres_per(symbol, path):
-    try:
-        return metres_per(symbol)
-    except InputError:
-        raise FormatError(f"OPDx {path!r} has unit {symbol!r}, not a length") from None
+    return length_unit(symbol, "OPDx PositionUnits unit")
 
 
 def _unit_name(symbol):

@@ -19,10 +19,9 @@ import struct
 
 import numpy as np
 
-from ..errors import FormatError, InputError
+from ..errors import FormatError
 from ..surface import Surface, Units, check_size
-from ..units import metres_per
-from .header import quiet
+from .header import length_unit, quiet
 from .registry import Format, channel_metadata
 
 MAGIC = 0x0E031301
@@ -77,7 +76,7 @@ def read(data, options):
         raise FormatError(f"Park Systems data tag holds {len(payload)} bytes, fewer than {nx}×{ny} points need")
     raw = np.frombuffer(payload, dtype, nx * ny).reshape(ny, nx)[::-1].astype(np.float64)
     z_unit = header["z_unit"] or "um"
-    metres = _metres(z_unit)
+    metres = length_unit(z_unit, "Park Systems z unit")
     heights = (raw * header["z_scale"] + header["z_offset"]) * header["data_gain"] * metres
     spacing = (header["width"] * 1e-6 / nx, header["height"] * 1e-6 / ny)
     name = header["source_name"] or "Z Height"
@@ -132,13 +131,6 @@ def _header(raw, least):
 
 def _utf16(raw, offset, characters):
     return raw[offset : offset + 2 * characters].decode("utf-16-le", errors="replace").split("\0", 1)[0].strip()
-
-
-def _metres(unit):
-    try:
-        return metres_per(unit)
-    except InputError:
-        raise FormatError(f"Park Systems z unit {unit!r} is not a length unit") from None
 
 
 def _tiff_metadata(tags):

@@ -127,31 +127,28 @@ def _starts(head, magic):
 
 
 @functools.cache
-def formats():
-    """Every format, ``{name: Format}`` in sniffing order."""
+def _modules():
+    """``{format name: module}`` in sniffing order."""
     table = {}
     for module_name in MODULES:
-        for declared in _declared(module(module_name)):
-            table[declared.name] = declared
+        format_module = module(module_name)
+        table[format_module.FORMAT.name] = format_module
     return table
 
 
 @functools.cache
+def formats():
+    """Every format, ``{name: Format}`` in sniffing order."""
+    return {name: format_module.FORMAT for name, format_module in _modules().items()}
+
+
 def module_of(name):
-    """The module that reads and writes format ``name``."""
-    for module_name in MODULES:
-        if any(declared.name == name for declared in _declared(module(module_name))):
-            return module(module_name)
-    raise KeyError(name)
+    """The module that reads and writes format ``name``; KeyError for an unknown name."""
+    return _modules()[name]
 
 
 def module(module_name):
     return importlib.import_module(f"rough.io.{module_name}")
-
-
-def _declared(format_module):
-    declared = format_module.FORMAT
-    return declared if isinstance(declared, tuple) else (declared,)
 
 
 def writable():

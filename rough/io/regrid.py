@@ -6,9 +6,11 @@ line through the first and the last; the spacing is that line's slope (the mean 
 and the origin the first x. Regridding is recorded in the surface's history.
 """
 
+import math
+
 import numpy as np
 
-from ..errors import FormatError
+from ..errors import FormatError, InputError
 from ..surface import Surface, Units, history_entry
 
 TOLERANCE = 1e-3  # of a step
@@ -56,6 +58,26 @@ def profile_from_points(x, z, options, *, units=Units(), metadata=None, history=
     return Surface(heights, (spacing,), (float(x[0]),), units, metadata, history)
 
 
+def option(value):
+    """``(spacing, method)`` from a ``--regrid`` value: a spacing in metres, or a
+    ``(spacing, method)`` pair (method default ``"bandlimited"``). Raises InputError
+    for a spacing that is not a positive length or an unknown method.
+
+    >>> option(5e-7), option((5e-7, "linear"))
+    ((5e-07, 'bandlimited'), (5e-07, 'linear'))
+    """
+    spacing, method = value if isinstance(value, (tuple, list)) else (value, "bandlimited")
+    try:
+        spacing = float(spacing)
+    except (TypeError, ValueError):
+        spacing = math.nan
+    if not spacing > 0:
+        raise InputError(f"the regrid spacing must be a positive length, got {value!r}")
+    if method not in METHODS:
+        raise InputError(f"unknown regrid method {method!r} (use {' or '.join(METHODS)})")
+    return spacing, method
+
+
 def regrid(x, z, spacing, method="bandlimited"):
     """Heights at ``x[0] + spacing * k`` (k = 0 … up to ``x[-1]``) from points ``(x, z)``
     with increasing x.
@@ -66,10 +88,7 @@ def regrid(x, z, spacing, method="bandlimited"):
     low-pass filter by FFT), so a coarser grid does not alias. Invalid (NaN) heights
     are skipped, and an interval of the new grid with no valid point near it is NaN.
     """
-    if method not in METHODS:
-        raise FormatError(f"unknown regrid method {method!r} (use {' or '.join(METHODS)})")
-    if not spacing > 0:
-        raise FormatError("the regrid spacing must be positive")
+    spacing, method = option((spacing, method))
     count = int(np.floor((x[-1] - x[0]) / spacing * (1 + 1e-12))) + 1
     if count < 2:
         raise FormatError(f"a regrid spacing of {spacing:.6g} m leaves fewer than two points")

@@ -30,10 +30,10 @@ import zlib
 
 import numpy as np
 
-from ..errors import FormatError, InputError
+from ..errors import FormatError
 from ..surface import Surface, Units, check_size
-from ..units import metres_per
 from . import limits, registry
+from .header import length_unit
 from .registry import Format
 
 FORMAT = Format(
@@ -180,10 +180,7 @@ def _inflate(data, header, offset):
 def _factor(unit):
     if not unit:
         return 1.0
-    try:
-        return metres_per(unit)
-    except InputError:
-        raise FormatError(f"SUR unit {unit!r} is not a length unit") from None
+    return length_unit(unit, "SUR unit")
 
 
 def _step(header, key):

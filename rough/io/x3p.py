@@ -570,8 +570,6 @@ def _gridded(x, y, z, options, what):
             f"{what}: give --regrid SPACING to grid it (rough reads point clouds and irregular grids only gridded)"
         )
     spacing, method = options.regrid
-    if method not in regrid.METHODS:
-        raise FormatError(f"unknown regrid method {method!r} (use {' or '.join(regrid.METHODS)})")
     if len(z) < 3:
         raise FormatError(f"{what} has {len(z)} valid points; gridding needs at least three")
     spans = [(float(v.max() - v.min()) / spacing) * (1 + 1e-12) for v in (x, y)]
