@@ -85,7 +85,8 @@ def regrid(x, z, spacing, method="bandlimited"):
     ``linear`` interpolates between neighbours. ``bandlimited`` first interpolates
     linearly onto a grid at least twice as fine as both ``spacing`` and the median step
     of x, then removes what lies above the new grid's Nyquist frequency (an ideal
-    low-pass filter by FFT), so a coarser grid does not alias. Invalid (NaN) heights
+    low-pass filter by FFT, after the line through the ends is taken out and before it
+    is put back, so that the ends do not ring), so a coarser grid does not alias. Invalid (NaN) heights
     are skipped, and an interval of the new grid with no valid point near it is NaN.
     """
     spacing, method = option((spacing, method))
@@ -103,9 +104,10 @@ def regrid(x, z, spacing, method="bandlimited"):
         factor = max(2, int(np.ceil(2 * spacing / np.median(np.diff(x)))))
         check_size((count * factor,), "the band-limited regrid's working grid")
         fine = np.interp(x[0] + spacing / factor * np.arange((count - 1) * factor + 1), x[valid], z[valid])
-        spectrum = np.fft.rfft(fine - fine.mean())
+        line = np.linspace(fine[0], fine[-1], len(fine))  # removed so that the ends meet: no ringing at the wrap
+        spectrum = np.fft.rfft(fine - line)
         spectrum[np.fft.rfftfreq(len(fine), spacing / factor) > 0.5 / spacing] = 0
-        heights = (np.fft.irfft(spectrum, len(fine)) + fine.mean())[::factor]
+        heights = (np.fft.irfft(spectrum, len(fine)) + line)[::factor]
     return np.where(_near_valid(target, x[valid], spacing, x), heights, np.nan)
 
 
