@@ -77,30 +77,50 @@ def features_figure(surface, features=(), density=None):
     return figure
 
 
-def spectrum_figure(frequencies, density, fit, title="power spectrum"):
-    """The binned spectrum on log-log axes with the fitted power law over its band
-    (profiles: G in m³; maps: the ring-averaged P2 in m⁴)."""
+def spectrum_figure(frequencies, density, fit, spacing, title="power spectrum"):
+    """The binned spectrum on log-log axes, the fit band shaded and the fitted model
+    (power law plus its noise floor) drawn over that band only (profiles: the Hann
+    periodogram G in m³, one-sided; maps: the ring-averaged P2 in m⁴). Without a
+    power-law range only the data are drawn."""
     plt = _pyplot()
     figure, axes = plt.subplots(figsize=(7, 5))
     axes.loglog(frequencies * 1e-3, density, "o", ms=3.5, color="0.35", label="binned periodogram")
-    low, high = fit.band
-    grid = np.geomspace(low, high, 100)
-    exponent = 5 - 2 * fit.fractal_dimension if fit.profile_dimension is None else 8 - 2 * fit.fractal_dimension
-    axes.loglog(
-        grid * 1e-3,
-        fit.psd_prefactor * grid**-exponent,
-        color="tab:red",
-        lw=2,
-        label=f"fit: {'D' if fit.profile_dimension is None else 'Ds'} = "
-        f"{fit.fractal_dimension:.4f} ± {fit.fractal_dimension_stderr:.4f}",
-    )
-    axes.axvspan(low * 1e-3, high * 1e-3, color="tab:red", alpha=0.06, label="fit band")
+    profile = fit.profile_dimension is None
+    if fit.fit_band is not None:
+        low, high = fit.fit_band
+        grid = np.geomspace(low, high, 200)
+        exponent = 5 - 2 * fit.fractal_dimension if profile else 8 - 2 * fit.fractal_dimension
+        power = fit.psd_prefactor * grid**-exponent
+        if fit.rolloff_wavelength:
+            power = power * np.exp(-((grid * fit.rolloff_wavelength) ** 2))
+        floor = (fit.noise_rms or 0.0) ** 2 * (2 * spacing[0] if profile else spacing[0] * spacing[1])
+        key = "D" if profile else "Ds"
+        label = (
+            f"{key} = {fit.fractal_dimension:.4f} (bound)"
+            if fit.at_bound
+            else f"{key} = {fit.fractal_dimension:.4f} ± {fit.fractal_dimension_stderr:.4f}"
+        )
+        axes.loglog(grid * 1e-3, power + floor, color="tab:red", lw=2, label=f"model: {label}")
+        if floor:
+            axes.loglog(grid * 1e-3, power, ":", color="tab:red", lw=1, label="power law alone")
+            axes.axhline(floor, xmin=0, xmax=1, color="tab:blue", lw=0.8, ls="--", label="noise floor")
+        axes.axvspan(low * 1e-3, high * 1e-3, color="tab:red", alpha=0.06, label=f"fit band, p = {fit.p_value:.2g}")
+        if fit.band and fit.band[1] < high:
+            axes.axvline(fit.band[1] * 1e-3, color="tab:blue", lw=0.8, label="noise crossover")
+    else:
+        axes.set_title(f"{title}\nno power-law range", fontsize=10)
     axes.set_xlabel("spatial frequency (1/mm)")
-    axes.set_ylabel("PSD G(f) (m³)" if fit.profile_dimension is None else "ring-averaged P2 (m⁴)")
-    axes.set_title(title)
+    axes.set_ylabel("PSD G(f) (m³)" if profile else "ring-averaged P2 (m⁴)")
+    if fit.fit_band is not None:
+        axes.set_title(title)
     axes.legend(fontsize="small")
     figure.tight_layout()
     return figure
+
+
+def _errors(values):
+    """Standard errors with None (a sector at a bound) drawn as zero."""
+    return np.array([0.0 if value is None else value for value in values])
 
 
 def rose_figure(rose, title="direction dependence"):
@@ -114,11 +134,11 @@ def rose_figure(rose, title="direction dependence"):
         (
             axes[0],
             np.array(rose.amplitude_coefficient) * 1e9,
-            np.array(rose.amplitude_coefficient_stderr) * 1e9,
+            _errors(rose.amplitude_coefficient_stderr) * 1e9,
             f"C(θ) (nm) at η = {rose.resolution * 1e6:.4g} µm",
             "tab:red",
         ),
-        (axes[1], np.array(rose.fractal_dimension), np.array(rose.fractal_dimension_stderr), "Ds(θ)", "tab:blue"),
+        (axes[1], np.array(rose.fractal_dimension), _errors(rose.fractal_dimension_stderr), "Ds(θ)", "tab:blue"),
     )
     for axis, values, errors, label, colour in panels:
         closed = np.concatenate([values, values, values[:1]])
@@ -128,13 +148,15 @@ def rose_figure(rose, title="direction dependence"):
         if axis is axes[1] and np.ptp(values) > 0:
             axis.set_ylim(max(2.0, float(np.min(values)) - 0.05), min(3.0, float(np.max(values)) + 0.05))
         inner, outer = axis.get_ylim()
-        for angle, style in ((rose.principal_direction, "-"), (rose.lay_direction, "--")):
+        lays = (rose.lay["long_wavelength"]["direction"], ":"), (rose.lay["resolution"]["direction"], "--")
+        for angle, style in ((rose.principal_direction, "-"), *lays):
             for direction in (angle, angle + 180):
                 axis.plot(np.radians([direction, direction]), [inner, outer], style, color="0.3", lw=1)
         axis.set_title(label, pad=14)
     figure.suptitle(
-        f"{title}\nprincipal wavevector {rose.principal_direction:.1f}° (solid), lay "
-        f"{rose.lay_direction:.1f}° (dashed); "
+        f"{title}\nprincipal wavevector {rose.principal_direction:.1f}° (solid); lay "
+        f"{rose.lay['resolution']['direction']:.1f}° at η (dashed), "
+        f"{rose.lay['long_wavelength']['direction']:.1f}° at long wavelengths (dotted); "
         f"Str {'undefined' if np.isnan(rose.Str) else format(rose.Str, '.3g')}, Std {rose.Std:.1f}°",
         fontsize=10,
     )

@@ -41,7 +41,7 @@ def test_anisotropic_map_gives_its_principal_directions(angle):
         assert abs(along["dimension"] - dimension) < 3 * along["dimension_error"]
         assert abs(math.log(along["amplitude"] / amplitude)) < 3 * along["amplitude_error"] / along["amplitude"]
     assert result.isotropy_p_value["amplitude_coefficient"] < 1e-6
-    assert angular_distance(result.lay_direction, angle) <= result.step
+    assert angular_distance(result.lay["resolution"]["direction"], angle) <= result.step
 
 
 def test_rotating_the_map_rotates_the_rose():

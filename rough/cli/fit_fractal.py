@@ -2,7 +2,7 @@
 
 import click
 
-from .options import BAND, LENGTH, crop_option, plot_option, report_format, surface_input
+from .options import BAND, LENGTH, crop_option, model_options, plot_option, report_format, surface_input
 from .report import emit, on_stdout
 
 
@@ -32,6 +32,7 @@ from .report import emit, on_stdout
     "when rough synthesised or resampled the surface, point samples otherwise.",
 )
 @click.option("--fill", is_flag=True, help="Fill invalid points first (linear along profiles, biharmonic in maps).")
+@model_options
 @click.option(
     "--psd",
     "psd_file",
@@ -41,7 +42,23 @@ from .report import emit, on_stdout
 )
 @plot_option("Draw the spectrum with the fitted power law on log-log axes; - is standard output, not the report.")
 @report_format
-def fit_fractal(surface, input, band, resolution, method, order, sampling, fill, psd_file, plot, as_json, as_tsv):
+def fit_fractal(
+    surface,
+    input,
+    band,
+    resolution,
+    method,
+    order,
+    sampling,
+    fill,
+    noise,
+    rolloff,
+    level,
+    psd_file,
+    plot,
+    as_json,
+    as_tsv,
+):
     """Fit the power law of INPUT's power spectrum (default: standard input): the
     fractal dimension D (a profile's, 1-2; a map's surface dimension Ds, 2-3, with
     the profile-equivalent D = Ds - 1 alongside) and the amplitude coefficient C of
@@ -49,9 +66,14 @@ def fit_fractal(surface, input, band, resolution, method, order, sampling, fill,
 
     The estimator maximises the Whittle likelihood of the periodogram of the
     profile's first differences under the exact spectrum of sampled fractal
-    surfaces; it is unbiased over the whole band, unlike a log-log line. Maps are
-    fitted on the ring-averaged, Hann-windowed 2-D periodogram. Every result names
-    its band, window, sampling model and method.
+    surfaces plus a white noise floor (and, with --rolloff, a short-wavelength
+    roll-off); maps are fitted on the ring-averaged, Hann-windowed 2-D periodogram.
+    Without --band the band is the scaling range: the widest band of at least a
+    decade over which the model passes a χ² goodness-of-fit test of the
+    periodogram at --level. Where none does, the verdict is "no power-law range"
+    and no D is printed; a D on the edge of the range is a bound, printed without
+    "±". Every result names its band, test p-value, noise floor, sampling model
+    and method.
 
     \b
     Examples:
@@ -67,7 +89,17 @@ def fit_fractal(surface, input, band, resolution, method, order, sampling, fill,
     report = not on_stdout(psd=psd_file, plot=plot)
     if fill:
         surface = fill_invalid(surface)
-    result = fit(surface, band=band, resolution=resolution, method=method, order=order, sampling=sampling)
+    result = fit(
+        surface,
+        band=band,
+        resolution=resolution,
+        method=method,
+        order=order,
+        sampling=sampling,
+        noise=noise,
+        rolloff=rolloff,
+        level=level,
+    )
     spectrum = binned_spectrum(surface, order) if (psd_file or plot or surface.is_profile) else None
     document = {**result.as_dict(), "points": surface.heights.size}
     if spectrum and "parseval" in spectrum:
@@ -94,6 +126,7 @@ def fit_fractal(surface, input, band, resolution, method, order, sampling, fill,
                 np.array(spectrum["frequency"]),
                 np.array(spectrum["density"]),
                 result,
+                surface.spacing,
                 surface.metadata.get("title", "power spectrum"),
             ),
             plot,
@@ -105,16 +138,14 @@ def fit_fractal(surface, input, band, resolution, method, order, sampling, fill,
 def _rows(result, surface, document):
     from ..units import format_length
 
-    low, high = result.band
     key = "D" if surface.is_profile else "Ds"
-    rows = [
-        (
-            "fractal_dimension",
-            result.fractal_dimension,
-            "1",
-            f"{key} = {result.fractal_dimension:.4f} ± {result.fractal_dimension_stderr:.4f} (standard error)",
-        ),
-    ]
+    if result.verdict == "no power-law range":
+        return [
+            ("verdict", result.verdict, "", f"no power-law range: {result.hint}"),
+            ("p_value", result.p_value, "1", f"{result.p_value:.3g} (the best of any band of a decade)"),
+            _method_row(result),
+        ]
+    rows = [("fractal_dimension", result.fractal_dimension, "1", _dimension_text(result, key))]
     if result.profile_dimension is not None:
         rows.append(
             (
@@ -124,13 +155,15 @@ def _rows(result, surface, document):
                 f"D = Ds - 1 = {result.profile_dimension:.4f} (profiles through the map)",
             )
         )
+    amplitude = format_length(result.amplitude_coefficient)
+    if not result.at_bound:
+        amplitude += f" ± {format_length(result.amplitude_coefficient_stderr)}"
     rows += [
         (
             "amplitude_coefficient",
             result.amplitude_coefficient,
             "m",
-            f"C = {format_length(result.amplitude_coefficient)} ± "
-            f"{format_length(result.amplitude_coefficient_stderr)} at η = {format_length(result.resolution)}",
+            f"C = {amplitude} at η = {format_length(result.resolution)}",
         ),
         (
             "psd_prefactor",
@@ -145,20 +178,62 @@ def _rows(result, surface, document):
             "m",
             f"{format_length(result.structure_function_coefficient)} (Ganti & Bhushan's C_S at η)",
         ),
+        ("band", list(result.band), "1/m", _band_text(result.band, "scaling range")),
         (
-            "band",
-            list(result.band),
+            "fit_band",
+            list(result.fit_band),
             "1/m",
-            (
-                f"{low * 1e-3:.4g} to {high * 1e-3:.4g} /mm (wavelengths {format_length(1 / high)} to "
-                f"{format_length(1 / low)}), "
-                f"{result.frequencies_used} frequencies"
-            ),
+            _band_text(result.fit_band, f"{result.frequencies_used} frequencies"),
         ),
-        ("method", result.method, "", f"{result.method}; window {result.window}; sampling {result.sampling}"),
     ]
+    if result.p_value is not None and result.p_value == result.p_value:
+        rows.append(("p_value", result.p_value, "1", f"{result.p_value:.3g} (goodness of fit: {result.test})"))
+    rows.append(("noise_rms", result.noise_rms, "m", _noise_text(result)))
+    if result.rolloff_wavelength:
+        rows.append(
+            ("rolloff_wavelength", result.rolloff_wavelength, "m", f"{format_length(result.rolloff_wavelength)} (1/fc)")
+        )
+    rows.append(_method_row(result))
     if "parseval" in document:
         rows.append(
             ("parseval", document["parseval"], "1", f"{document['parseval']:.12f} (Σ G Δf over the windowed variance)")
         )
     return rows
+
+
+def _dimension_text(result, key):
+    if result.at_bound:
+        return f"{key} = {result.fractal_dimension:.4f}: at the edge of the fractal range, a bound ({result.hint})"
+    return f"{key} = {result.fractal_dimension:.4f} ± {result.fractal_dimension_stderr:.4f} (standard error)"
+
+
+def _band_text(band, what):
+    from ..units import format_length
+
+    low, high = band
+    return (
+        f"{low * 1e-3:.4g} to {high * 1e-3:.4g} /mm (wavelengths {format_length(1 / high)} to "
+        f"{format_length(1 / low)}), {what}"
+    )
+
+
+def _noise_text(result):
+    from ..units import format_length
+
+    if result.noise_rms is None:
+        return "no white noise floor found"
+    crossing = (
+        f", above the power law from {result.noise_crossover * 1e-3:.4g} /mm"
+        if result.noise_crossover
+        else ", below the power law throughout the band"
+    )
+    return f"{format_length(result.noise_rms)} RMS white noise floor{crossing}"
+
+
+def _method_row(result):
+    return (
+        "method",
+        result.method,
+        "",
+        f"{result.method}; window {result.window}; sampling {result.sampling} ({result.sampling_source})",
+    )

@@ -158,6 +158,33 @@ def crop_option(command):
     )(command)
 
 
+def model_options(command):
+    """The spectral model's options, shared by ``fit-fractal`` and ``rose``: ``--no-noise``,
+    ``--rolloff`` and the goodness-of-fit test's ``--level``."""
+    for option in reversed(
+        (
+            click.option(
+                "--noise/--no-noise",
+                default=True,
+                show_default=True,
+                help="Fit a white noise floor along with the power law (kept when the likelihood ratio finds it).",
+            ),
+            click.option(
+                "--rolloff", is_flag=True, help="Also fit a Gaussian short-wavelength roll-off (tip, optics)."
+            ),
+            click.option(
+                "--level",
+                type=click.FloatRange(0, 1, min_open=True, max_open=True),
+                default=0.01,
+                show_default=True,
+                help="Goodness-of-fit level for the automatic band (the widest band whose p reaches it).",
+            ),
+        )
+    ):
+        command = option(command)
+    return command
+
+
 class RegridType(SpacingType):
     """``SPACING`` or ``SPACING:linear|bandlimited`` → (metres, method)."""
 

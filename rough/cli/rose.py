@@ -2,7 +2,7 @@
 
 import click
 
-from .options import BAND, LENGTH, crop_option, plot_option, report_format, surface_input
+from .options import BAND, LENGTH, crop_option, model_options, plot_option, report_format, surface_input
 from .report import echo, emit, on_stdout
 
 
@@ -28,16 +28,23 @@ from .report import echo, emit, on_stdout
 )
 @click.option("--sampling", type=click.Choice(["point", "band-limited"]), help="As for fit-fractal.")
 @click.option("--fill", is_flag=True, help="Fill invalid points first (biharmonic inpainting).")
+@model_options
 @plot_option("Draw polar roses of C(θ) and D(θ), mirrored to 360°; - is standard output, instead of the report.")
 @report_format
-def rose(surface, input, step, width, band, resolution, order, sampling, fill, plot, as_json, as_tsv):
+def rose(
+    surface, input, step, width, band, resolution, order, sampling, fill, noise, rolloff, level, plot, as_json, as_tsv
+):
     """Fit the surface dimension Ds(θ) and amplitude coefficient C(θ) of the map
     INPUT (default: standard input) in direction sectors of its Hann-windowed 2-D
     power spectrum, with the axis lines, where a map's edges leak, left out. θ is the
     wavevector direction, counter-clockwise from +x (the direction in which heights
-    vary; ridges run at right angles). Reports the principal direction (largest C),
-    Ds and C along it and across it, χ² tests of isotropy, and ISO 25178-2 Str and
-    Std. Unequal x and y spacing is handled exactly (physical frequencies).
+    vary; ridges run at right angles). The band is the whole map's scaling range
+    (as for fit-fractal) unless --band is given; each sector gets its own noise
+    floor. Reports the principal direction (largest C), Ds and C along it and
+    across it, the lay at the long-wavelength end and at the resolution η (on a
+    fault surface read the long-wavelength lay as the slip direction), χ² tests of
+    isotropy over the sectors not at a bound, and ISO 25178-2 Str and Std. Unequal
+    x and y spacing is handled exactly (physical frequencies).
 
     \b
     Examples:
@@ -52,7 +59,16 @@ def rose(surface, input, step, width, band, resolution, order, sampling, fill, p
     if fill:
         surface = fill_invalid(surface)
     result = directions(
-        surface, step=step, width=width, band=band, resolution=resolution, order=order, sampling=sampling
+        surface,
+        step=step,
+        width=width,
+        band=band,
+        resolution=resolution,
+        order=order,
+        sampling=sampling,
+        noise=noise,
+        rolloff=rolloff,
+        level=level,
     )
     if plot:
         from .. import plots
@@ -68,23 +84,34 @@ def rose(surface, input, step, width, band, resolution, order, sampling, fill, p
 
 def _print_tsv(result):
     echo(
-        "angle_deg\tfractal_dimension\tfractal_dimension_stderr\tamplitude_coefficient_m\tamplitude_coefficient_stderr_m"
+        "angle_deg\tfractal_dimension\tfractal_dimension_stderr\tamplitude_coefficient_m"
+        "\tamplitude_coefficient_stderr_m\tat_bound"
     )
-    for row in zip(
+    for *row, bound in zip(
         result.angles,
         result.fractal_dimension,
         result.fractal_dimension_stderr,
         result.amplitude_coefficient,
         result.amplitude_coefficient_stderr,
+        result.at_bound,
     ):
-        echo("\t".join(repr(float(value)) for value in row))
+        echo("\t".join(["" if value is None else repr(float(value)) for value in row] + [str(bound).lower()]))
+
+
+def _sector_text(dimension, dimension_error, amplitude, amplitude_error):
+    from ..units import format_length
+
+    if dimension_error is None:
+        return f"Ds = {dimension:.4f} (bound)   C = {format_length(amplitude)}"
+    spread = f"{format_length(amplitude)} ± {format_length(amplitude_error)}"
+    return f"Ds = {dimension:.4f} ± {dimension_error:.4f}   C = {spread}"
 
 
 def _rows(result):
     from ..units import format_length, format_quantity
 
     rows = [
-        (f"θ = {angle:5.1f}°", [d, c], "", f"Ds = {d:.4f} ± {de:.4f}   C = {format_length(c)} ± {format_length(ce)}")
+        (f"θ = {angle:5.1f}°", [d, c], "", _sector_text(d, de, c, ce))
         for angle, d, de, c, ce in zip(
             result.angles,
             result.fractal_dimension,
@@ -95,32 +122,42 @@ def _rows(result):
     ]
     principal, across = result.principal, result.perpendicular
     isotropy = result.isotropy_p_value
+    long_lay, fine_lay = result.lay["long_wavelength"], result.lay["resolution"]
+    bound = sum(result.at_bound)
     rows += [
         (
             "principal",
             result.principal_direction,
             "deg",
-            (
-                f"{result.principal_direction:.1f}° (largest C of the rose's cos 2θ part): "
-                f"Ds = {principal['dimension']:.4f} ± {principal['dimension_error']:.4f}, "
-                f"C = {format_length(principal['amplitude'])} ± {format_length(principal['amplitude_error'])}"
+            f"{result.principal_direction:.1f}° (largest C of the rose's cos 2θ part): "
+            + _sector_text(
+                principal["dimension"],
+                principal["dimension_error"],
+                principal["amplitude"],
+                principal["amplitude_error"],
             ),
         ),
         (
             "perpendicular",
             (result.principal_direction + 90) % 180,
             "deg",
-            (
-                f"{(result.principal_direction + 90) % 180:.1f}°: "
-                f"Ds = {across['dimension']:.4f} ± {across['dimension_error']:.4f}, "
-                f"C = {format_length(across['amplitude'])} ± {format_length(across['amplitude_error'])}"
+            f"{(result.principal_direction + 90) % 180:.1f}°: "
+            + _sector_text(
+                across["dimension"], across["dimension_error"], across["amplitude"], across["amplitude_error"]
             ),
         ),
         (
-            "lay",
-            result.lay_direction,
+            "lay_long_wavelength",
+            long_lay["direction"],
             "deg",
-            f"{result.lay_direction:.1f}° (ridges run at right angles to the principal wavevector)",
+            f"{long_lay['direction']:.1f}° (ridges at wavelength {format_length(long_lay['wavelength'])}, the band's "
+            "long end: on a fault, the slip direction)",
+        ),
+        (
+            "lay_resolution",
+            fine_lay["direction"],
+            "deg",
+            f"{fine_lay['direction']:.1f}° (ridges at η = {format_length(fine_lay['wavelength'])}, the finest texture)",
         ),
         (
             "largest_sector",
@@ -128,11 +165,12 @@ def _rows(result):
             "deg",
             f"{result.largest_sector:.1f}° (the sector with the largest C)",
         ),
+        ("at_bound", bound, "1", f"{bound} of {len(result.angles)} sectors have Ds at a bound (left out of the tests)"),
         (
             "isotropy",
             isotropy,
             "",
-            "not tested (overlapping sectors)"
+            "not tested (overlapping sectors, or fewer than two sectors inside the range)"
             if isotropy["fractal_dimension"] is None
             else f"χ² p-values: Ds flat {isotropy['fractal_dimension']:.3g}, "
             f"C flat {isotropy['amplitude_coefficient']:.3g}",
@@ -144,8 +182,9 @@ def _rows(result):
             list(result.band),
             "1/m",
             (
-                f"{result.band[0] * 1e-3:.4g} to {result.band[1] * 1e-3:.4g} /mm, sectors {result.width:g}° wide "
-                f"every {result.step:g}°, C at η = {format_length(result.resolution)}, sampling {result.sampling}"
+                f"{result.band[0] * 1e-3:.4g} to {result.band[1] * 1e-3:.4g} /mm ({result.verdict} over the whole map, "
+                f"p = {result.p_value:.3g}), sectors {result.width:g}° wide every {result.step:g}°, C at "
+                f"η = {format_length(result.resolution)}, sampling {result.sampling}"
             ),
         ),
     ]

@@ -44,8 +44,9 @@ log = logging.getLogger("rough")
 METHODS = ("whittle", "variogram", "madogram", "loglog")
 SAMPLINGS = ("point", "band-limited")
 BETA_RANGE = (1.0 + 1e-6, 3.0 - 1e-6)
-LOWEST_RING = 8
+LOWEST_RING = 4
 RESAMPLED_TOP = 0.8
+EVIDENCE = 1.5  # log-likelihood units in favour of band-limited data before point samples are given up
 FLAT = 1e-9  # RMS residual below this fraction of the largest height is rounding, not roughness
 
 
@@ -89,6 +90,37 @@ class FractalFit:
         (docs/math.rst §1.2).
     profile_dimension : float or None
         For maps, Ds - 1, the D of the profiles through the map; None for profiles.
+    verdict : str
+        ``"power law"`` (D strictly inside the fractal range), ``"at bound"`` (the
+        exponent sits on the edge of the range: D is a bound, not an estimate, and
+        its standard error is None) or ``"no power-law range"`` (no band of a decade
+        or more passes the goodness-of-fit test: D, C and their errors are NaN).
+    at_bound : bool
+        Whether the verdict is ``"at bound"``.
+    p_value : float
+        The goodness-of-fit test's p-value over the fit band (see ``test``); NaN for
+        the cross-check methods.
+    test : str
+        The goodness-of-fit test (docs/math.rst §1.7).
+    fit_band : tuple of float
+        The frequencies in the likelihood, 1/m: ``band`` is this band up to the
+        noise crossover.
+    noise_rms : float or None
+        The RMS of the white noise floor, metres; None when the likelihood ratio
+        finds no floor.
+    noise_crossover : float or None
+        The frequency where the power law meets the noise floor, 1/m; None when
+        it does not within the fit band.
+    rolloff_wavelength : float or None
+        The wavelength 1/fc of the fitted Gaussian roll-off, metres; None unless
+        ``rolloff=True``.
+    sampling_source : str
+        Where ``sampling`` came from: ``option``, ``history``, ``likelihood`` (both
+        models fitted, the likelier kept) or ``maps: band`` (aliasing is not modelled
+        for maps; the default band stops below it).
+    hint : str or None
+        At a bound or without a power-law range: where the spectrum's local exponent
+        comes nearest a fractal's, as a band to try.
 
     Notes
     -----
@@ -104,7 +136,7 @@ class FractalFit:
     >>> print(f"C = {fit.amplitude_coefficient * 1e9:.0f} nm at η = {fit.resolution * 1e6:.1f} µm")
     C = 260 nm at η = 30.9 µm
     >>> sorted(fit.as_dict())[:3]
-    ['amplitude_coefficient', 'amplitude_coefficient_stderr', 'band']
+    ['amplitude_coefficient', 'amplitude_coefficient_stderr', 'at_bound']
     """
 
     fractal_dimension: float
@@ -121,10 +153,21 @@ class FractalFit:
     frequencies_used: int
     structure_function_coefficient: float
     profile_dimension: float = None
+    verdict: str = "power law"
+    at_bound: bool = False
+    p_value: float = math.nan
+    test: str = ""
+    fit_band: tuple = None
+    noise_rms: float = None
+    noise_crossover: float = None
+    rolloff_wavelength: float = None
+    sampling_source: str = "option"
+    hint: str = None
 
     def as_dict(self):
         values = dataclasses.asdict(self)
-        values["band"] = list(self.band)
+        values["band"] = None if self.band is None else list(self.band)
+        values["fit_band"] = None if self.fit_band is None else list(self.fit_band)
         if self.profile_dimension is None:
             del values["profile_dimension"]
         return values
@@ -146,7 +189,18 @@ def default_top(surface, nyquist, sampling):
     return nyquist if sampling == "band-limited" or surface.is_profile else nyquist / 2
 
 
-def fit_fractal(surface, band=None, resolution=None, method="whittle", order=1, sampling=None, sector=None):
+def fit_fractal(
+    surface,
+    band=None,
+    resolution=None,
+    method="whittle",
+    order=1,
+    sampling=None,
+    sector=None,
+    noise=True,
+    rolloff=False,
+    level=0.01,
+):
     """The fractal dimension D (Ds for maps) and amplitude coefficient C of a surface.
 
     Parameters
@@ -155,10 +209,12 @@ def fit_fractal(surface, band=None, resolution=None, method="whittle", order=1, 
         A gap-free profile or map: invalid (NaN) points must have been filled (see
         :func:`rough.fractal.resample.fill_invalid`).
     band : tuple of (float or None), optional
-        ``(fmin, fmax)`` in 1/m, either end None for its default: from the lowest
-        frequency (maps: the eighth ring) up to the Nyquist frequency for profiles
-        and band-limited maps, half of it for point-sampled maps, and 80 % of it
-        after rough's resample.
+        ``(fmin, fmax)`` in 1/m. With both ends given, exactly that band is fitted.
+        Otherwise (the default) the band is the scaling range: the widest band of at
+        least a decade inside the limits (the given end, else from the lowest
+        frequency, for maps the fourth ring, up to the Nyquist frequency for profiles
+        and band-limited maps, half of it for point-sampled maps, 80 % of it after
+        rough's resample) over which the model passes the goodness-of-fit test.
     resolution : float, optional
         The η in metres at which C is stated; default the (smaller) spacing.
     method : {"whittle", "variogram", "madogram", "loglog"}, default "whittle"
@@ -170,10 +226,23 @@ def fit_fractal(surface, band=None, resolution=None, method="whittle", order=1, 
     sampling : {"point", "band-limited"}, optional
         Whether power above the Nyquist frequency folded back when the data were
         sampled (``point``) or not (``band-limited``: what rough's synthesis and
-        resampling make). Default: read from the surface's history.
+        resampling make). Default: band-limited when the surface's history says rough
+        made its spectrum; otherwise, for profiles, chosen by likelihood (point
+        samples unless band-limited is likelier by 1.5 in log-likelihood) and, for
+        maps, point samples with the band stopping at half the Nyquist frequency.
     sector : tuple of float, optional
         Maps only: ``(angle, width)`` in radians, to fit only the wavevectors within
         ``width/2`` of ``angle`` (mod 180°).
+    noise : bool, default True
+        Fit a white noise floor along with the power law (kept when the likelihood
+        ratio against no floor passes its 0.1 % test and the floor rises above the
+        power law inside the band); its RMS is reported in metres.
+    rolloff : bool, default False
+        Also fit a Gaussian short-wavelength roll-off ``exp(-(f/fc)²)`` of the power
+        law (a tip's or the optics' transfer); 1/fc is reported.
+    level : float, default 0.01
+        The goodness-of-fit test's level for the automatic band: the widest band
+        (at least a decade) whose p-value reaches it is fitted.
 
     Returns
     -------
@@ -222,7 +291,7 @@ def fit_fractal(surface, band=None, resolution=None, method="whittle", order=1, 
     the spectrum needs gap-free data: this surface has invalid points (fill them with --fill)
     >>> fit = fit_fractal(fill_invalid(scan))
     >>> print(f"Ds = {fit.fractal_dimension:.2f} ± {fit.fractal_dimension_stderr:.2f}, D = {fit.profile_dimension:.2f}")
-    Ds = 2.33 ± 0.04, D = 1.33
+    Ds = 2.34 ± 0.03, D = 1.34
     """
     from ..metrology import detrend
 
@@ -230,88 +299,218 @@ def fit_fractal(surface, band=None, resolution=None, method="whittle", order=1, 
         raise InputError(f"method must be one of {', '.join(METHODS)}, not {method!r}")
     if np.isnan(surface.heights).any():
         raise InputError("the spectrum needs gap-free data: this surface has invalid points (fill them with --fill)")
-    sampling = sampling or sampling_of(surface)
-    if sampling not in SAMPLINGS:
+    if sampling is not None and sampling not in SAMPLINGS:
         raise InputError(f"sampling must be one of {', '.join(SAMPLINGS)}, not {sampling!r}")
+    if not 0 < level < 1:
+        raise InputError(f"the test's level must lie between 0 and 1, not {level}")
+    options = Options(noise, rolloff, level)
+    source = "option" if sampling else "history" if history_sampling(surface) else None
+    sampling = sampling or sampling_of(surface)
     resolution = resolution or min(surface.spacing)
     if surface.is_profile:
         if sector is not None:
             raise InputError("a direction (sector) needs a map")
-        fitter = {"whittle": _whittle_profile, "variogram": _variogram, "madogram": _madogram, "loglog": _loglog}[
-            method
-        ]
-        if method == "whittle" and (band is None or band[1] is None):
-            band = ((band or (None, None))[0], default_top(surface, 0.5 / surface.spacing[0], sampling))
         levelled = detrend(surface, order=order).heights
         refuse_flat(levelled, surface.heights)
-        return _announce_undefined(fitter(levelled, surface.spacing[0], band, resolution, sampling))
+        if method != "whittle":
+            cross_check = {"variogram": _variogram, "madogram": _madogram, "loglog": _loglog}[method]
+            return _announce(cross_check(levelled, surface.spacing[0], band, resolution, sampling))
+        top = default_top(surface, 0.5 / surface.spacing[0], sampling)
+        explicit = band is not None and None not in band
+        band = ((band or (None, None))[0], top if band is None or band[1] is None else band[1])
+        fit = _whittle_profile(levelled, surface.spacing[0], band, explicit, resolution, (sampling, source), options)
+        return _announce(fit)
     if method != "whittle":
         raise InputError(f"maps are fitted by the Whittle method only, not {method}")
-    fit = _whittle_map(surface, order, band, resolution, sampling, sector)
-    return fit if sector is not None else _announce_undefined(fit)
+    fit = _whittle_map(surface, order, band, resolution, (sampling, source or "maps: band"), sector, options)
+    return fit if sector is not None else _announce(fit)
+
+
+@dataclasses.dataclass
+class Options:
+    """The spectral model's options: a white noise floor (kept when the likelihood
+    ratio finds it), a Gaussian roll-off, and the goodness-of-fit test's level."""
+
+    noise: bool = True
+    rolloff: bool = False
+    level: float = 0.01
+
+
+def history_sampling(surface):
+    """``"band-limited"`` when the surface's history says rough made its spectrum
+    (synth, resample), None when it does not say."""
+    made = {entry.get("command") for entry in surface.history}
+    return "band-limited" if made & {"synth", "resample"} else None
+
+
+def _outcome(bins, exponent_range, explicit, options):
+    from .scaling import fit_band, scaling_range
+
+    if explicit:
+        return fit_band(bins, exponent_range, options.noise, options.rolloff)
+    return scaling_range(bins, exponent_range, options.level, noise=options.noise, rolloff=options.rolloff)
 
 
 # -- profiles: Whittle on the differences ------------------------------------------------
 
 
-def _whittle_profile(heights, spacing, band, resolution, sampling):
+def _difference_periodogram(heights, spacing):
+    """``(f, I)``: the two-sided periodogram Δ/m |DFT|² of the first differences at
+    0 < f < the Nyquist frequency (1/m, m²·m)."""
     differences = np.diff(heights)
     m = differences.size
     transform = np.fft.rfft(differences)
     k = np.arange(1, (m - 1) // 2 + 1)
-    frequencies = k / (m * spacing)
-    ordinates = spacing / m * np.abs(transform[k]) ** 2
+    return k / (m * spacing), spacing / m * np.abs(transform[k]) ** 2
+
+
+def _whittle_profile(heights, spacing, band, explicit, resolution, sampling, options):
+    from .scaling import profile_bins
+
+    frequencies, ordinates = _difference_periodogram(heights, spacing)
     keep = _in_band(frequencies, band)
     if keep.sum() < 8:
         raise InputError(f"only {keep.sum()} frequencies in the fit band; widen --band or use more points")
-    u, ordinates = k[keep] / m, ordinates[keep]
-    shape = _difference_shape(u, spacing, sampling)
-
-    def profile_likelihood(beta):
-        log_shape = shape(beta)
-        return len(u) * math.log(np.mean(ordinates * np.exp(-log_shape))) + log_shape.sum()
-
-    beta = _minimise(profile_likelihood)
-    if at_fractal_edge(beta):
-        warn_at_edge()
-    scale = np.mean(ordinates * np.exp(-shape(beta)))  # = 2A
-    derivative = (shape(beta + 1e-5) - shape(beta - 1e-5)) / 2e-5
-    covariance = np.linalg.inv(np.array([[len(u), derivative.sum()], [derivative.sum(), (derivative**2).sum()]]))
-    return _result(
-        beta,
-        covariance,
-        scale / 2,
+    frequencies, ordinates = frequencies[keep], ordinates[keep]
+    sampling, source = sampling
+    samplings = SAMPLINGS if source is None else (sampling,)
+    outcomes = {
+        name: _outcome(profile_bins(frequencies, spacing, ordinates, name), BETA_RANGE, explicit, options)
+        for name in samplings
+    }
+    sampling, outcome, spread = _likelier(outcomes, spacing, options)
+    return _from_outcome(
+        outcome,
+        "profile",
         resolution,
-        _band_of(frequencies[keep]),
-        "whittle",
-        "none (first differences)",
-        sampling,
-        len(u),
+        _SETTINGS(
+            "whittle",
+            "none (first differences)",
+            sampling,
+            source or "likelihood",
+            spread,
+            len(outcome.fit.bins) if outcome.fit else int(keep.sum()),
+        ),
     )
 
 
-def _difference_shape(u, spacing, sampling):
-    """log of the differences' spectrum over 2A, as a function of β (vectorised
-    over the normalised frequencies u = fΔ in (0, 1/2))."""
-    sine = np.log(np.sin(np.pi * u) ** 2)
-    log_u = np.log(u)
-    grid = np.linspace(u.min(), u.max(), 257) if u.size > 257 else u
-
-    def shape(beta):
-        base = -beta * log_u
-        if sampling == "point":
-            folded = model.aliased_sum(beta, grid) - grid**-beta
-            base = base + np.log1p(np.interp(u, grid, folded) * u**beta)
-        return sine + beta * math.log(spacing) + base
-
-    return shape
+_SETTINGS = dataclasses.make_dataclass("_SETTINGS", ["method", "window", "sampling", "source", "spread", "count"])
 
 
-def _minimise(function):
-    from scipy.optimize import minimize_scalar
+def _likelier(outcomes, spacing, options):
+    """``(sampling, outcome, spread)``: of the samplings' outcomes, the one with the
+    better verdict and the wider band; over its band both sampling models are then
+    fitted without a noise floor (two parameters each, so their likelihoods compare
+    directly: a floor could stand in for the folded power). Instruments take point
+    samples, so band-limited is chosen only when its log-likelihood is larger by
+    EVIDENCE and its exponent is not on a bound; the model chosen then gets its floor
+    if the likelihood ratio finds one. When the log-likelihoods
+    differ by less than 1, half the difference of their exponents is ``spread``
+    (added to the standard error)."""
+    from .scaling import conclude, fit_spectrum, profile_bins
 
-    result = minimize_scalar(function, bounds=BETA_RANGE, method="bounded", options={"xatol": 1e-7})
-    return float(result.x)
+    rank = {"power law": 2, "at bound": 1, "no power-law range": 0}
+
+    def quality(item):
+        outcome = item[1]
+        return rank[outcome.verdict], math.log10(outcome.band[1] / outcome.band[0]) if outcome.band else 0.0
+
+    sampling, outcome = max(outcomes.items(), key=quality)
+    if len(outcomes) == 1 or outcome.fit is None:
+        return sampling, outcome, 0.0
+    frequencies, density = outcome.fit.bins.frequency, outcome.fit.bins.density
+    plain = {
+        name: fit_spectrum(profile_bins(frequencies, spacing, density, name), BETA_RANGE, False, options.rolloff)
+        for name in SAMPLINGS
+    }
+    likelier = "band-limited" if plain["point"].nll - plain["band-limited"].nll > EVIDENCE else "point"
+    if at_fractal_edge(plain[likelier].exponent):
+        likelier = sampling
+    close = abs(plain["point"].nll - plain["band-limited"].nll) < 1
+    spread = abs(plain["point"].exponent - plain["band-limited"].exponent) / 2 if close else 0.0
+    if likelier == sampling:
+        return sampling, outcome, spread
+    fit = fit_spectrum(
+        profile_bins(frequencies, spacing, density, likelier), BETA_RANGE, options.noise, options.rolloff
+    )
+    return likelier, conclude(fit, BETA_RANGE, outcome.best_p, fit.bins.grouped()), spread
+
+
+def _from_outcome(outcome, kind, resolution, settings):
+    """A :class:`FractalFit` from a scaling outcome (see :mod:`rough.fractal.scaling`)."""
+    from .scaling import TEST_NAME
+
+    profile = kind == "profile"
+    fit = outcome.fit
+    common = {
+        "resolution": resolution,
+        "method": settings.method,
+        "window": settings.window,
+        "sampling": settings.sampling,
+        "sampling_source": settings.source,
+        "frequencies_used": settings.count,
+        "verdict": outcome.verdict,
+        "test": TEST_NAME,
+        "p_value": outcome.p_value,
+    }
+    if fit is None:
+        nan = math.nan
+        return FractalFit(
+            nan,
+            nan,
+            nan,
+            nan,
+            psd_prefactor=nan,
+            hurst=nan,
+            band=None,
+            structure_function_coefficient=nan,
+            profile_dimension=None if profile else nan,
+            hint=outcome.hint,
+            **common,
+        )
+    values = _dimension_and_amplitude(fit, resolution, profile)
+    bound = outcome.verdict == "at bound"
+    dimension_error = None if bound else math.hypot(values["dimension_error"], settings.spread)
+    crossover = fit.crossover()
+    return FractalFit(
+        fractal_dimension=values["dimension"],
+        fractal_dimension_stderr=dimension_error,
+        amplitude_coefficient=values["amplitude"],
+        amplitude_coefficient_stderr=None if bound else values["amplitude_error"],
+        psd_prefactor=fit.prefactor,
+        hurst=(2.0 if profile else 3.0) - values["dimension"],
+        band=outcome.scaling_range,
+        structure_function_coefficient=values["amplitude"]
+        / model.structure_factor(values["dimension"] - (0.0 if profile else 1.0)),
+        profile_dimension=None if profile else values["dimension"] - 1.0,
+        at_bound=bound,
+        fit_band=outcome.band,
+        noise_rms=math.sqrt(fit.noise_variance) if fit.noise_variance else None,
+        noise_crossover=crossover if math.isfinite(crossover) and crossover < outcome.band[1] else None,
+        rolloff_wavelength=1.0 / fit.rolloff if fit.rolloff else None,
+        hint=outcome.hint,
+        **common,
+    )
+
+
+def _dimension_and_amplitude(fit, resolution, profile):
+    """D (or Ds), C at η and their standard errors from a spectral fit: for a profile
+    β = 5 - 2D and A is G's prefactor; for a map α = 8 - 2Ds and C2 is P2's."""
+    if profile:
+        dimension = (5.0 - fit.exponent) / 2.0
+        amplitude = model.amplitude(fit.prefactor, dimension, resolution)
+        gradient = np.array([1.0, math.log(resolution)])
+    else:
+        dimension = (8.0 - fit.exponent) / 2.0
+        amplitude = model.map_amplitude(fit.prefactor, dimension, resolution)
+        gradient = np.array([1.0, math.log(resolution) - _map_factor_slope(dimension)])
+    covariance = fit.covariance
+    return {
+        "dimension": dimension,
+        "dimension_error": math.sqrt(max(covariance[1, 1], 0.0)) / 2,
+        "amplitude": amplitude,
+        "amplitude_error": amplitude * math.sqrt(max(gradient @ covariance @ gradient, 0.0)),
+    }
 
 
 def refuse_flat(residual, heights):
@@ -326,41 +525,21 @@ def at_fractal_edge(beta):
     return min(abs(beta - b) for b in BETA_RANGE) < 1e-3
 
 
-def warn_at_edge(where="", dimension="D at 1 or 2"):
-    log.warning(
-        f"the fitted exponent is at the edge of the fractal range ({dimension}){where}: the data do not "
-        "follow a fractal power law in this band (see --band)"
-    )
+UNDEFINED_CHECKED = ("amplitude_coefficient", "psd_prefactor", "structure_function_coefficient")
 
 
-UNDEFINED_CHECKED = ("fractal_dimension", "amplitude_coefficient", "psd_prefactor", "structure_function_coefficient")
-
-
-def _result(beta, covariance, prefactor, resolution, band, method, window, sampling, count):
-    dimension = (5.0 - beta) / 2.0
-    amplitude = model.amplitude(prefactor, dimension, resolution)
-    gradient = np.array([1.0, math.log(resolution)])
-    log_error = math.sqrt(max(gradient @ covariance @ gradient, 0.0))
-    fit = FractalFit(
-        fractal_dimension=dimension,
-        fractal_dimension_stderr=math.sqrt(max(covariance[1, 1], 0.0)) / 2,
-        amplitude_coefficient=amplitude,
-        amplitude_coefficient_stderr=amplitude * log_error,
-        resolution=resolution,
-        psd_prefactor=prefactor,
-        hurst=2.0 - dimension,
-        band=band,
-        method=method,
-        window=window,
-        sampling=sampling,
-        frequencies_used=count,
-        structure_function_coefficient=amplitude / model.structure_factor(dimension),
-    )
-    return fit
-
-
-def _announce_undefined(fit):
-    """One warning naming every result that came out undefined (NaN or infinite)."""
+def _announce(fit):
+    """One warning for a verdict other than a power law, and one naming every result
+    that came out undefined (NaN or infinite) although a power law was fitted."""
+    dimension = "D" if fit.profile_dimension is None else "Ds"
+    if fit.verdict == "at bound":
+        log.warning(
+            f"{dimension} = {fit.fractal_dimension:g} is at the edge of the fractal range: a bound, not an "
+            f"estimate{'; ' + fit.hint if fit.hint else ''}"
+        )
+    elif fit.verdict == "no power-law range":
+        log.warning(f"no power-law range: {fit.hint or 'no band of a decade passes the test'}")
+        return fit
     values = {name: getattr(fit, name) for name in UNDEFINED_CHECKED}
     values["band"] = min(fit.band, default=math.nan) if fit.band else math.nan
     undefined = [name for name, value in values.items() if value is None or not math.isfinite(value)]
@@ -388,6 +567,8 @@ def _band_of(frequencies):
 
 # -- maps: ring-binned Whittle -------------------------------------------------------------
 
+MAP_RANGE = (BETA_RANGE[0] + 1.0, BETA_RANGE[1] + 1.0)
+
 
 def map_band(surface, band, sampling):
     """``(step, low, high)`` of a map's ring fit (1/m): the ring spacing (the coarser of
@@ -402,76 +583,44 @@ def map_band(surface, band, sampling):
     return step, low, high
 
 
-def _whittle_map(surface, order, band, resolution, sampling, sector):
-    step, low, high = map_band(surface, band, sampling)
+def _whittle_map(surface, order, band, resolution, sampling, sector, options):
+    from .scaling import ring_bins
+
+    step, low, high = map_band(surface, band, sampling[0])
     field, power = windowed_map(surface, order)
     refuse_flat(field, surface.heights)
     rings = ring_spectrum(field, power, surface.spacing, low, high, step, sector)
     del field
     if rings["count"].size < 4:
         raise InputError(f"only {rings['count'].size} frequency rings in the fit band; widen --band")
-    fit = ring_fit(rings, resolution)
-    if fit["at_edge"]:
-        warn_at_edge(dimension="Ds at 2 or 3")
-    surface_dimension, amplitude = fit["dimension"], fit["amplitude"]
-    return FractalFit(
-        fractal_dimension=surface_dimension,
-        fractal_dimension_stderr=fit["dimension_error"],
-        amplitude_coefficient=amplitude,
-        amplitude_coefficient_stderr=fit["amplitude_error"],
-        resolution=resolution,
-        psd_prefactor=fit["prefactor"],
-        hurst=3.0 - surface_dimension,
-        band=(float(low), float(high)),
-        method="whittle (ring-binned 2-D periodogram)" + ("" if sector is None else ", sector"),
-        window="hann (periodic)",
-        sampling=sampling,
-        frequencies_used=int(rings["count"].sum()),
-        structure_function_coefficient=amplitude / model.structure_factor(surface_dimension - 1.0),
-        profile_dimension=surface_dimension - 1.0,
-    )
+    explicit = band is not None and None not in band
+    outcome = _outcome(ring_bins(rings, surface.spacing), MAP_RANGE, explicit, options)
+    count = int(outcome.fit.bins.count.sum()) if outcome.fit else int(rings["count"].sum())
+    method = "whittle (ring-binned 2-D periodogram)" + ("" if sector is None else ", sector")
+    settings = _SETTINGS(method, "hann (periodic)", sampling[0], sampling[1], 0.0, count)
+    return _from_outcome(outcome, "map", resolution, settings)
 
 
-def ring_fit(rings, resolution):
-    """Ds and C (at η = ``resolution``) with standard errors from ring means, and
-    whether the exponent sits at the edge of the fractal range."""
-    alpha, prefactor, covariance = _fit_rings(rings)
-    dimension = (8.0 - alpha) / 2.0
-    amplitude = model.map_amplitude(prefactor, dimension, resolution)
-    gradient = np.array([1.0, math.log(resolution) - _map_factor_slope(dimension)])
+def ring_fit(bins, resolution, options):
+    """A sector's fit (rose): Ds and C (at η = ``resolution``) with standard errors
+    (None at a bound), the noise RMS (m, None without a floor) and whether the
+    exponent sits at the edge of the fractal range."""
+    from .scaling import fit_spectrum
+
+    fit = fit_spectrum(bins, MAP_RANGE, options.noise, options.rolloff)
+    values = _dimension_and_amplitude(fit, resolution, profile=False)
+    bound = at_fractal_edge(fit.exponent - 1.0)
     return {
-        "dimension": dimension,
-        "dimension_error": math.sqrt(max(covariance[1, 1], 0.0)) / 2,
-        "amplitude": amplitude,
-        "amplitude_error": amplitude * math.sqrt(max(gradient @ covariance @ gradient, 0.0)),
-        "prefactor": float(prefactor),
-        "frequencies_used": int(rings["count"].sum()),
-        "at_edge": at_fractal_edge(alpha - 1.0),
+        "dimension": values["dimension"],
+        "dimension_error": None if bound else values["dimension_error"],
+        "amplitude": values["amplitude"],
+        "amplitude_error": None if bound else values["amplitude_error"],
+        "prefactor": float(fit.prefactor),
+        "frequencies_used": int(bins.count.sum()),
+        "at_bound": bound,
+        "noise_rms": math.sqrt(fit.noise_variance) if fit.noise_variance else None,
+        "fit": fit,
     }
-
-
-def _fit_rings(rings):
-    """Gamma (binned Whittle) fit of C2 |f|^-α to ring means. The expected mean of a
-    ring is C2 · exp(-α μ + α² σ²/2) (μ, σ² the mean and variance of log |f| in the
-    ring) times the window's smoothing, 1 + (α(α+2) a - α b)/6 to second order, with
-    a = <(sx² fx² + sy² fy²)/|f|⁴> and b = <(sx² + sy²)/|f|²> (sx, sy the frequency
-    steps). Returns ``(α, C2, covariance of (log C2, α))``."""
-    dof = rings["count"] / rings["window_factor"]
-    means = rings["density"]
-
-    def log_shape(alpha):
-        smoothing = 1.0 + (alpha * (alpha + 2.0) * rings["window_a"] - alpha * rings["window_b"]) / 6.0
-        return -alpha * rings["log_radius"] + 0.5 * alpha**2 * rings["log_spread"] + np.log(smoothing)
-
-    def profile_likelihood(alpha):
-        shape = log_shape(alpha)
-        return dof.sum() * math.log(np.sum(dof * means * np.exp(-shape)) / dof.sum()) + np.sum(dof * shape)
-
-    alpha = _minimise(lambda beta: profile_likelihood(beta + 1.0)) + 1.0
-    prefactor = float(np.sum(dof * means * np.exp(-log_shape(alpha))) / dof.sum())
-    derivative = (log_shape(alpha + 1e-5) - log_shape(alpha - 1e-5)) / 2e-5
-    fisher = np.array([[dof.sum(), np.sum(dof * derivative)], [np.sum(dof * derivative), np.sum(dof * derivative**2)]])
-    return alpha, prefactor, np.linalg.inv(fisher)
 
 
 def _map_factor_slope(surface_dimension):
@@ -483,6 +632,33 @@ def _map_factor_slope(surface_dimension):
 
 
 # -- profiles: cross-check methods -----------------------------------------------------------
+
+
+def _result(beta, prefactor, resolution, band, method, window, sampling, count):
+    """A cross-check's result: the exponent clamped to the fractal range (a bound is
+    reported as such), the errors filled in by the caller."""
+    beta = min(max(beta, BETA_RANGE[0]), BETA_RANGE[1])
+    dimension = (5.0 - beta) / 2.0
+    amplitude = model.amplitude(prefactor, dimension, resolution)
+    bound = at_fractal_edge(beta)
+    return FractalFit(
+        fractal_dimension=dimension,
+        fractal_dimension_stderr=math.nan,
+        amplitude_coefficient=amplitude,
+        amplitude_coefficient_stderr=math.nan,
+        resolution=resolution,
+        psd_prefactor=prefactor,
+        hurst=2.0 - dimension,
+        band=band,
+        method=method,
+        window=window,
+        sampling=sampling,
+        frequencies_used=count,
+        structure_function_coefficient=amplitude / model.structure_factor(dimension),
+        verdict="at bound" if bound else "power law",
+        at_bound=bound,
+        fit_band=band,
+    )
 
 
 def _lag_statistic(heights, lag, statistic):
@@ -512,7 +688,6 @@ def _lag_result(heights, spacing, resolution, statistic, sampling):
     error = _blocks(heights, lambda part: _lag_fit(part, spacing, resolution, statistic)[0])
     fit = _result(
         5.0 - 2.0 * dimension,
-        np.zeros((2, 2)),
         model.prefactor(amplitude, dimension, resolution),
         resolution,
         (1 / (2 * spacing), 1 / spacing),
@@ -521,8 +696,7 @@ def _lag_result(heights, spacing, resolution, statistic, sampling):
         sampling,
         2,
     )
-    fit.fractal_dimension_stderr = error
-    fit.amplitude_coefficient_stderr = math.nan
+    fit.fractal_dimension_stderr = None if fit.at_bound else error
     return fit
 
 
@@ -552,7 +726,6 @@ def _loglog(heights, spacing, band, resolution, sampling):
     beta, prefactor, used, count = _loglog_estimate(heights, spacing, band)
     fit = _result(
         beta,
-        np.zeros((2, 2)),
         prefactor,
         resolution,
         used,
@@ -561,6 +734,6 @@ def _loglog(heights, spacing, band, resolution, sampling):
         sampling,
         count,
     )
-    fit.fractal_dimension_stderr = _blocks(heights, lambda part: (5.0 - _loglog_estimate(part, spacing, None)[0]) / 2)
-    fit.amplitude_coefficient_stderr = math.nan
+    error = _blocks(heights, lambda part: (5.0 - _loglog_estimate(part, spacing, None)[0]) / 2)
+    fit.fractal_dimension_stderr = None if fit.at_bound else error
     return fit

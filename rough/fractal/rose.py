@@ -21,13 +21,16 @@ the anisotropy is significant. Str and Std (ISO 25178-2) come along.
 """
 
 import dataclasses
+import logging
 import math
 
 import numpy as np
 
 from ..errors import InputError
-from .fit import map_band, refuse_flat, ring_fit, sampling_of, warn_at_edge
+from .fit import MAP_RANGE, Options, _outcome, map_band, refuse_flat, ring_fit, sampling_of
 from .psd import sector_spectra, windowed_map
+
+log = logging.getLogger("rough")
 
 
 @dataclasses.dataclass
@@ -48,11 +51,23 @@ class Rose:
         The profile-equivalent amplitude coefficient C(θ) in each sector, metres.
     amplitude_coefficient_stderr : list of float
         Its standard error in each sector, metres.
+    at_bound : list of bool
+        Whether each sector's Ds sits on the edge of the fractal range: a bound, not
+        an estimate (its standard errors are None, and it is left out of the
+        principal direction and the isotropy tests).
+    noise_rms : list of float or None
+        The white noise floor's RMS fitted in each sector, metres (None: no floor).
     principal_direction : float
-        θp, the direction of the largest C in a weighted fit of the rose's
-        elliptical part, ``log C(θ) = a + b cos 2(θ - θp)``; degrees in [0, 180).
-    lay_direction : float
-        θp + 90° (mod 180°): the direction in which the ridges run, degrees.
+        θp, the direction of the largest C (the spectrum at the resolution η) in a
+        weighted fit of the rose's elliptical part, ``log C(θ) = a + b cos 2(θ - θp)``;
+        degrees in [0, 180).
+    lay : dict
+        The direction in which the ridges run, per scale: ``long_wavelength`` (from
+        the sectors' power at the band's lowest frequency) and ``resolution`` (θp +
+        90°, from C at η), each ``{"direction": degrees, "wavelength": metres}``.
+        On a fault surface the long-wavelength lay is the corrugation, i.e. the slip
+        direction; the resolution lay is the finest texture, where scan lines and
+        interpolation also show.
     largest_sector : float
         The centre of the sector with the largest C, degrees (may differ from θp for
         a rose that is not elliptical).
@@ -64,14 +79,21 @@ class Rose:
         The same at θp + 90°.
     isotropy_p_value : dict
         p-values of χ² tests that ``fractal_dimension`` and ``amplitude_coefficient``
-        (its log) are the same in every sector; None for overlapping sectors
-        (``width > step``), which are not independent.
+        (its log) are the same in every sector not at a bound; None for overlapping
+        sectors (``width > step``), which are not independent, or when fewer than two
+        sectors are inside the range.
     Str : float
         ISO 25178-2 texture aspect ratio of the levelled map (NaN when undefined).
     Std : float
         ISO 25178-2 texture direction of the levelled map, degrees.
     band : tuple of float
-        ``(fmin, fmax)``, the frequencies fitted, 1/m.
+        ``(fmin, fmax)``, the frequencies fitted, 1/m: the scaling range of the whole
+        map (see :func:`~rough.fractal.fit.fit_fractal`) unless ``band`` was given.
+    verdict : str
+        The whole map's verdict over that band: ``power law``, ``at bound`` or ``no
+        power-law range`` (then the sectors are fitted over the default band).
+    p_value : float
+        The whole map's goodness-of-fit p-value over the band.
     resolution : float
         The η at which C is stated, metres.
     step : float
@@ -93,7 +115,7 @@ class Rose:
     >>> result = rose(fill_invalid(rough.read(rough.sample("rock-map.x3p"))), step=30)
     >>> result.angles
     [0, 30, 60, 90, 120, 150]
-    >>> len(result.fractal_dimension), round(result.lay_direction - result.principal_direction, 6)
+    >>> len(result.fractal_dimension), round(result.lay["resolution"]["direction"] - result.principal_direction, 6)
     (6, 90.0)
     """
 
@@ -102,8 +124,10 @@ class Rose:
     fractal_dimension_stderr: list
     amplitude_coefficient: list
     amplitude_coefficient_stderr: list
+    at_bound: list
+    noise_rms: list
     principal_direction: float
-    lay_direction: float
+    lay: dict
     largest_sector: float
     principal: dict
     perpendicular: dict
@@ -111,6 +135,8 @@ class Rose:
     Str: float
     Std: float
     band: tuple
+    verdict: str
+    p_value: float
     resolution: float
     step: float
     width: float
@@ -122,7 +148,18 @@ class Rose:
         return values
 
 
-def rose(surface, step=10.0, width=None, band=None, resolution=None, order=1, sampling=None):
+def rose(
+    surface,
+    step=10.0,
+    width=None,
+    band=None,
+    resolution=None,
+    order=1,
+    sampling=None,
+    noise=True,
+    rolloff=False,
+    level=0.01,
+):
     """D(θ) and C(θ) of a map: the amplitude coefficient rose.
 
     The map's form is removed, it is tapered with the periodic Hann window and its
@@ -148,6 +185,10 @@ def rose(surface, step=10.0, width=None, band=None, resolution=None, order=1, sa
         The degree of the polynomial form removed first.
     sampling : {"point", "band-limited"}, optional
         Default: read from the surface's history.
+    noise, rolloff, level
+        The spectral model and the test, as for :func:`~rough.fractal.fit.fit_fractal`;
+        the band is chosen once on the whole map, and every sector gets its own
+        noise floor.
 
     Returns
     -------
@@ -180,8 +221,8 @@ def rose(surface, step=10.0, width=None, band=None, resolution=None, order=1, sa
     >>> anisotropy = (2.2, 1e-6, 2.5, 3e-6, math.radians(30))
     >>> scan = synthesize_map((256, 256), (10e-6, 10e-6), None, anisotropy=anisotropy, seed=1)
     >>> result = rose(scan, step=15)
-    >>> round(result.principal_direction), round(result.lay_direction)  # degrees
-    (118, 28)
+    >>> round(result.principal_direction), round(result.lay["resolution"]["direction"])  # degrees
+    (119, 29)
     >>> print(f"C {result.perpendicular['amplitude'] * 1e6:.2f} µm, Ds {result.perpendicular['dimension']:.2f}")
     C 1.00 µm, Ds 2.20
     >>> result.isotropy_p_value["amplitude_coefficient"] < 1e-6
@@ -199,40 +240,38 @@ def rose(surface, step=10.0, width=None, band=None, resolution=None, order=1, sa
         raise InputError(f"the step must divide 180° and the width lie in (0°, 180°]: step {step}°, width {width}°")
     sampling = sampling or sampling_of(surface)
     resolution = resolution or min(surface.spacing)
+    options = Options(noise, rolloff, level)
     frequency_step, low, high = map_band(surface, band, sampling)
     from scipy import fft
+
+    from .scaling import ring_bins
 
     field, power = windowed_map(surface, order)
     refuse_flat(field, surface.heights)
     transform = fft.rfft2(field, workers=-1)
+
+    def spectra(low, high, sectors):
+        return sector_spectra(field, power, surface.spacing, low, high, frequency_step, sectors, transform=transform)
+
+    whole = spectra(low, high, None)[0]
+    _enough(whole)
+    outcome = _outcome(ring_bins(whole, surface.spacing), MAP_RANGE, band is not None and None not in band, options)
+    low, high = outcome.band or (low, high)
     count = round(180 / step)
-    sectors = sector_spectra(
-        field,
-        power,
-        surface.spacing,
-        low,
-        high,
-        frequency_step,
-        (0.0, math.radians(step), count, math.radians(width)),
-        transform=transform,
-    )
-    fits = [_sector_fit(rings, resolution) for rings in sectors]
-    at_edge = sum(fit["at_edge"] for fit in fits)
-    if at_edge:
-        warn_at_edge(f" in {at_edge} of {count} sectors", "Ds at 2 or 3")
+    sectors = spectra(low * (1 - 1e-9), high * (1 + 1e-9), (0.0, math.radians(step), count, math.radians(width)))
+    fits = [_sector_fit(rings, surface.spacing, resolution, options) for rings in sectors]
+    bound = [fit["at_bound"] for fit in fits]
+    if any(bound):
+        log.warning(f"Ds is at the edge of the fractal range (a bound) in {sum(bound)} of {count} sectors")
     angles = [k * step for k in range(count)]
-    principal = _principal_direction(angles, fits)
-    along = sector_spectra(
-        field,
-        power,
-        surface.spacing,
-        low,
-        high,
-        frequency_step,
-        (math.radians(principal), math.pi / 2, 2, math.radians(width)),
-        transform=transform,
-    )
-    del field, transform
+    usable = [fit for fit in fits if not fit["at_bound"]]
+    usable_angles = [angle for angle, fit in zip(angles, fits) if not fit["at_bound"]]
+    if len(usable) < 3:
+        usable, usable_angles = fits, angles
+    principal = _principal_direction(usable_angles, [_level(fit, 1 / resolution) for fit in usable])
+    along = spectra(low * (1 - 1e-9), high * (1 + 1e-9), (math.radians(principal), math.pi / 2, 2, math.radians(width)))
+    long_end = _principal_direction(usable_angles, [_level(fit, low) for fit in usable])
+    field = transform = None  # free the spectrum before Str and Std
     levelled = detrend(surface, order=order)
     str_ratio = autocorrelation_lengths(levelled)[1]
     return Rose(
@@ -241,17 +280,22 @@ def rose(surface, step=10.0, width=None, band=None, resolution=None, order=1, sa
         fractal_dimension_stderr=[f["dimension_error"] for f in fits],
         amplitude_coefficient=[f["amplitude"] for f in fits],
         amplitude_coefficient_stderr=[f["amplitude_error"] for f in fits],
+        at_bound=bound,
+        noise_rms=[f["noise_rms"] for f in fits],
         principal_direction=principal,
-        lay_direction=(principal + 90.0) % 180.0,
+        lay={
+            "long_wavelength": {"direction": (long_end + 90.0) % 180.0, "wavelength": 1 / low},
+            "resolution": {"direction": (principal + 90.0) % 180.0, "wavelength": resolution},
+        },
         largest_sector=angles[int(np.argmax([f["amplitude"] for f in fits]))],
-        principal=_sector_fit(along[0], resolution),
-        perpendicular=_sector_fit(along[1], resolution),
-        isotropy_p_value=_flatness(fits)
-        if width <= step + 1e-9
-        else {"fractal_dimension": None, "amplitude_coefficient": None},
+        principal=_summary(_sector_fit(along[0], surface.spacing, resolution, options)),
+        perpendicular=_summary(_sector_fit(along[1], surface.spacing, resolution, options)),
+        isotropy_p_value=_flatness([fit for fit in fits if not fit["at_bound"]], width <= step + 1e-9),
         Str=str_ratio,
         Std=texture_direction(levelled),
         band=(float(low), float(high)),
+        verdict=outcome.verdict,
+        p_value=outcome.p_value,
         resolution=resolution,
         step=step,
         width=width,
@@ -259,31 +303,52 @@ def rose(surface, step=10.0, width=None, band=None, resolution=None, order=1, sa
     )
 
 
-def _sector_fit(rings, resolution):
+def _enough(rings):
     if rings["count"].size < 4:
         raise InputError(
             f"a sector holds only {rings['count'].size} frequency rings in the band; use wider sectors "
             f"(--width) or a wider band"
         )
-    return ring_fit(rings, resolution)
 
 
-def _principal_direction(angles, fits):
-    """θp from a weighted least-squares fit of log C(θ) = a + p cos 2θ + q sin 2θ:
-    the direction of the largest C, in degrees in [0, 180)."""
+def _sector_fit(rings, spacing, resolution, options):
+    from .scaling import ring_bins
+
+    _enough(rings)
+    return ring_fit(ring_bins(rings, spacing), resolution, options)
+
+
+def _summary(fit):
+    return {key: value for key, value in fit.items() if key != "fit"}
+
+
+def _level(sector, frequency):
+    """``(log P2, its standard error)`` of a sector's power law at ``frequency``."""
+    fit = sector["fit"]
+    gradient = np.array([1.0, -math.log(frequency)])
+    error = math.sqrt(max(gradient @ fit.covariance @ gradient, 0.0))
+    return math.log(fit.prefactor) - fit.exponent * math.log(frequency), error if math.isfinite(error) else 1.0
+
+
+def _principal_direction(angles, levels):
+    """θp from a weighted least-squares fit of ``log P2(θ) = a + p cos 2θ + q sin 2θ``
+    to ``levels`` (pairs of log level and standard error): the direction of the
+    largest power, in degrees in [0, 180)."""
     theta = np.radians(angles)
     design = np.column_stack([np.ones_like(theta), np.cos(2 * theta), np.sin(2 * theta)])
-    log_c = np.log([f["amplitude"] for f in fits])
-    weights = 1.0 / np.maximum([(f["amplitude_error"] / f["amplitude"]) ** 2 for f in fits], 1e-30)
-    root = np.sqrt(weights)
-    _, p, q = np.linalg.lstsq(design * root[:, None], log_c * root, rcond=None)[0]
+    values = np.array([value for value, _ in levels])
+    root = 1.0 / np.maximum([error for _, error in levels], 1e-15)
+    _, p, q = np.linalg.lstsq(design * root[:, None], values * root, rcond=None)[0]
     return float(math.degrees(0.5 * math.atan2(q, p)) % 180.0)
 
 
-def _flatness(fits):
-    """p-values of χ² tests that D(θ) and log C(θ) are constant (independent sectors)."""
+def _flatness(fits, independent):
+    """p-values of χ² tests that D(θ) and log C(θ) are constant over the sectors not
+    at a bound; None for overlapping sectors (not independent) or fewer than two."""
     from scipy.stats import chi2
 
+    if not independent or len(fits) < 2:
+        return {"fractal_dimension": None, "amplitude_coefficient": None}
     result = {}
     for key, values, errors in (
         ("fractal_dimension", [f["dimension"] for f in fits], [f["dimension_error"] for f in fits]),

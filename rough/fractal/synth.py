@@ -204,7 +204,7 @@ def synthesize_map(
     ((128, 256), dtype('float64'))
     >>> fit = fit_fractal(scan)
     >>> print(f"Ds = {fit.fractal_dimension:.2f} ± {fit.fractal_dimension_stderr:.2f}")
-    Ds = 2.42 ± 0.02
+    Ds = 2.44 ± 0.02
     >>> sq = synthesize_map((64, 64), (10e-6, 10e-6), 2.4, rq=1e-6, seed=3)
     >>> f"{np.std(sq.heights) * 1e6:.6f} µm"  # exactly the Sq asked for
     '1.000000 µm'
