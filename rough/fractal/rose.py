@@ -224,7 +224,7 @@ def rose(
     >>> round(result.principal_direction), round(result.lay["resolution"]["direction"])  # degrees
     (119, 29)
     >>> print(f"C {result.perpendicular['amplitude'] * 1e6:.2f} µm, Ds {result.perpendicular['dimension']:.2f}")
-    C 1.00 µm, Ds 2.20
+    C 1.07 µm, Ds 2.22
     >>> result.isotropy_p_value["amplitude_coefficient"] < 1e-6
     True
     """
