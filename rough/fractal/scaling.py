@@ -246,24 +246,24 @@ def gof_p_value(bins, expected, parameters, per_decade=GOF_PER_DECADE):
     return float(stats.chi2.sf(np.sum(np.minimum(z**2, 1e6)), freedom))
 
 
-def fit_spectrum(bins, exponent_range, noise=True, rolloff=False, start=None):
+def fit_spectrum(bins, exponent_range, noise=True, rolloff=False):
     """The maximum-likelihood fit of the model to ``bins``: a :class:`SpectralFit`.
 
     ``noise`` fits a white floor, kept only when the likelihood ratio against no floor
     passes its 0.1 % test and the floor rises above the power law within the band (a
     floor that never dominates is confounded with a flatter power law; so an exact
     power law keeps the efficiency of the two-parameter fit); ``rolloff`` fits a
-    Gaussian roll-off. ``start`` is a previous fit's (exponent, log ratio, log fc).
+    Gaussian roll-off.
     """
-    plain = _fit(bins, exponent_range, False, rolloff, start)
+    plain = _fit(bins, exponent_range, False, rolloff)
     if not noise:
         return plain
-    floored = _fit(bins, exponent_range, True, rolloff, start)
+    floored = _fit(bins, exponent_range, True, rolloff)
     found = 2 * (plain.nll - floored.nll) > NOISE_TEST and floored.crossover() < bins.frequency[-1]
     return floored if found else plain
 
 
-def _fit(bins, exponent_range, noise, rolloff, start):
+def _fit(bins, exponent_range, noise, rolloff):
     from scipy.optimize import minimize, minimize_scalar
 
     weight, density, total = bins.weight, bins.density, bins.weight.sum()
@@ -299,9 +299,8 @@ def _fit(bins, exponent_range, noise, rolloff, start):
         theta = [minimize_scalar(lambda e: nll([e]), bounds=(low, high), method="bounded", options={"xatol": 1e-7}).x]
     else:
         bounds = [(low, high), NOISE_LOG_RATIO, (-3.0, 3.0)]
-        if start is None:
-            plain = minimize_scalar(lambda e: nll([e, NOISE_LOG_RATIO[0], 3.0]), bounds=(low, high), method="bounded")
-            start = [plain.x, -4.0, 1.0]
+        plain = minimize_scalar(lambda e: nll([e, NOISE_LOG_RATIO[0], 3.0]), bounds=(low, high), method="bounded")
+        start = [plain.x, -4.0, 1.0]
         best = None
         for ratio in (start[1], 0.0) if noise else (start[1],):
             guess = [min(max(start[0], low + 1e-3), high - 1e-3), ratio, start[2]]
