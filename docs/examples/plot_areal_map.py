@@ -94,5 +94,5 @@ print(f"band {low * 1e-3:.3g} to {high * 1e-3:.3g} /mm")
 
 spectrum = binned_spectrum(filled)
 fig = rough.plots.spectrum_figure(
-    np.array(spectrum["frequency"]), np.array(spectrum["density"]), fit, title="rock-map.x3p"
+    np.array(spectrum["frequency"]), np.array(spectrum["density"]), fit, filled.spacing, title="rock-map.x3p"
 )

@@ -58,7 +58,11 @@ print(f"sampling model: {fit.sampling}")
 
 spectrum = binned_spectrum(profile)
 fig = rough.plots.spectrum_figure(
-    np.array(spectrum["frequency"]), np.array(spectrum["density"]), fit, title=profile.metadata["title"]
+    np.array(spectrum["frequency"]),
+    np.array(spectrum["density"]),
+    fit,
+    profile.spacing,
+    title=profile.metadata["title"],
 )
 
 # %%

@@ -61,7 +61,11 @@ plt.show()
 
 result = rough.rose(surface, step=10)
 along, across = result.principal, result.perpendicular
-print(f"principal wavevector direction: {result.principal_direction:.1f}° (lay {result.lay_direction:.1f}°)")
+print(
+    f"principal wavevector direction: {result.principal_direction:.1f}° (lay at η "
+    f"{result.lay['resolution']['direction']:.1f}°, "
+    f"at long wavelengths {result.lay['long_wavelength']['direction']:.1f}°)"
+)
 print(
     f"along it:        Ds = {along['dimension']:.3f} ± {along['dimension_error']:.3f}, "
     f"C = {along['amplitude'] * 1e6:.2f} ± {along['amplitude_error'] * 1e6:.2f} µm   (made with 2.2, 3 µm)"
