@@ -39,6 +39,7 @@ import numpy as np
 from ..errors import InputError
 from . import model
 from .psd import periodogram, ring_spectrum, windowed_map
+from .scaling import at_bound, decades
 
 log = logging.getLogger("rough")
 METHODS = ("whittle", "variogram", "madogram", "loglog")
@@ -176,8 +177,7 @@ class FractalFit:
 def sampling_of(surface):
     """``"band-limited"`` when rough made the surface's spectrum (synth, resample),
     ``"point"`` otherwise."""
-    made = {entry.get("command") for entry in surface.history}
-    return "band-limited" if made & {"synth", "resample"} else "point"
+    return history_sampling(surface) or "point"
 
 
 def default_top(surface, nyquist, sampling):
@@ -315,10 +315,7 @@ def fit_fractal(
         if method != "whittle":
             cross_check = {"variogram": _variogram, "madogram": _madogram, "loglog": _loglog}[method]
             return _announce(cross_check(levelled, surface.spacing[0], band, resolution, sampling))
-        top = default_top(surface, 0.5 / surface.spacing[0], sampling)
-        explicit = band is not None and None not in band
-        band = ((band or (None, None))[0], top if band is None or band[1] is None else band[1])
-        fit = _whittle_profile(levelled, surface.spacing[0], band, explicit, resolution, (sampling, source), options)
+        fit = _whittle_profile(levelled, surface, band, resolution, (sampling, source), options)
         return _announce(fit)
     if method != "whittle":
         raise InputError(f"maps are fitted by the Whittle method only, not {method}")
@@ -343,10 +340,12 @@ def history_sampling(surface):
     return "band-limited" if made & {"synth", "resample"} else None
 
 
-def _outcome(bins, exponent_range, explicit, options):
+def band_outcome(bins, exponent_range, band, options):
+    """The fit over ``band`` when both its ends are given, else over the scaling range
+    found inside ``bins`` (see :mod:`rough.fractal.scaling`)."""
     from .scaling import fit_band, scaling_range
 
-    if explicit:
+    if band is not None and None not in band:
         return fit_band(bins, exponent_range, options.noise, options.rolloff)
     return scaling_range(bins, exponent_range, options.level, noise=options.noise, rolloff=options.rolloff)
 
@@ -364,18 +363,20 @@ def _difference_periodogram(heights, spacing):
     return k / (m * spacing), spacing / m * np.abs(transform[k]) ** 2
 
 
-def _whittle_profile(heights, spacing, band, explicit, resolution, sampling, options):
+def _whittle_profile(heights, surface, band, resolution, sampling, options):
     from .scaling import profile_bins
 
+    spacing = surface.spacing[0]
     frequencies, ordinates = _difference_periodogram(heights, spacing)
-    keep = _in_band(frequencies, band)
+    top = default_top(surface, 0.5 / spacing, sampling[0])
+    keep = _in_band(frequencies, ((band or (None, None))[0], top if band is None or band[1] is None else band[1]))
     if keep.sum() < 8:
         raise InputError(f"only {keep.sum()} frequencies in the fit band; widen --band or use more points")
     frequencies, ordinates = frequencies[keep], ordinates[keep]
     sampling, source = sampling
     samplings = SAMPLINGS if source is None else (sampling,)
     outcomes = {
-        name: _outcome(profile_bins(frequencies, spacing, ordinates, name), BETA_RANGE, explicit, options)
+        name: band_outcome(profile_bins(frequencies, spacing, ordinates, name), BETA_RANGE, band, options)
         for name in samplings
     }
     sampling, outcome, spread = _likelier(outcomes, spacing, options)
@@ -413,7 +414,7 @@ def _likelier(outcomes, spacing, options):
 
     def quality(item):
         outcome = item[1]
-        return rank[outcome.verdict], math.log10(outcome.band[1] / outcome.band[0]) if outcome.band else 0.0
+        return rank[outcome.verdict], decades(*outcome.band) if outcome.band else 0.0
 
     sampling, outcome = max(outcomes.items(), key=quality)
     if len(outcomes) == 1 or outcome.fit is None:
@@ -424,7 +425,7 @@ def _likelier(outcomes, spacing, options):
         for name in SAMPLINGS
     }
     likelier = "band-limited" if plain["point"].nll - plain["band-limited"].nll > EVIDENCE else "point"
-    if at_fractal_edge(plain[likelier].exponent):
+    if at_bound(plain[likelier].exponent, BETA_RANGE):
         likelier = sampling
     close = abs(plain["point"].nll - plain["band-limited"].nll) < 1
     spread = abs(plain["point"].exponent - plain["band-limited"].exponent) / 2 if close else 0.0
@@ -520,11 +521,6 @@ def refuse_flat(residual, heights):
         raise InputError("the surface is flat once its form is removed: there is no roughness to fit")
 
 
-def at_fractal_edge(beta):
-    """Whether a fitted profile exponent β (or map α - 1) sits at the end of (1, 3)."""
-    return min(abs(beta - b) for b in BETA_RANGE) < 1e-3
-
-
 UNDEFINED_CHECKED = ("amplitude_coefficient", "psd_prefactor", "structure_function_coefficient")
 
 
@@ -593,8 +589,7 @@ def _whittle_map(surface, order, band, resolution, sampling, sector, options):
     del field
     if rings["count"].size < 4:
         raise InputError(f"only {rings['count'].size} frequency rings in the fit band; widen --band")
-    explicit = band is not None and None not in band
-    outcome = _outcome(ring_bins(rings, surface.spacing), MAP_RANGE, explicit, options)
+    outcome = band_outcome(ring_bins(rings, surface.spacing), MAP_RANGE, band, options)
     count = int(outcome.fit.bins.count.sum()) if outcome.fit else int(rings["count"].sum())
     method = "whittle (ring-binned 2-D periodogram)" + ("" if sector is None else ", sector")
     settings = _SETTINGS(method, "hann (periodic)", sampling[0], sampling[1], 0.0, count)
@@ -609,7 +604,7 @@ def ring_fit(bins, resolution, options):
 
     fit = fit_spectrum(bins, MAP_RANGE, options.noise, options.rolloff)
     values = _dimension_and_amplitude(fit, resolution, profile=False)
-    bound = at_fractal_edge(fit.exponent - 1.0)
+    bound = at_bound(fit.exponent, MAP_RANGE)
     return {
         "dimension": values["dimension"],
         "dimension_error": None if bound else values["dimension_error"],
@@ -640,7 +635,7 @@ def _result(beta, prefactor, resolution, band, method, window, sampling, count):
     beta = min(max(beta, BETA_RANGE[0]), BETA_RANGE[1])
     dimension = (5.0 - beta) / 2.0
     amplitude = model.amplitude(prefactor, dimension, resolution)
-    bound = at_fractal_edge(beta)
+    bound = at_bound(beta, BETA_RANGE)
     return FractalFit(
         fractal_dimension=dimension,
         fractal_dimension_stderr=math.nan,

@@ -27,7 +27,7 @@ import math
 import numpy as np
 
 from ..errors import InputError
-from .fit import MAP_RANGE, Options, _outcome, map_band, refuse_flat, ring_fit, sampling_of
+from .fit import MAP_RANGE, Options, band_outcome, map_band, refuse_flat, ring_fit, sampling_of
 from .psd import sector_spectra, windowed_map
 
 log = logging.getLogger("rough")
@@ -255,7 +255,7 @@ def rose(
 
     whole = spectra(low, high, None)[0]
     _enough(whole)
-    outcome = _outcome(ring_bins(whole, surface.spacing), MAP_RANGE, band is not None and None not in band, options)
+    outcome = band_outcome(ring_bins(whole, surface.spacing), MAP_RANGE, band, options)
     low, high = outcome.band or (low, high)
     count = round(180 / step)
     sectors = spectra(low * (1 - 1e-9), high * (1 + 1e-9), (0.0, math.radians(step), count, math.radians(width)))

@@ -234,10 +234,10 @@ def power_law_found(fit):
 def gof_p_value(bins, expected, parameters, per_decade=GOF_PER_DECADE):
     from scipy import stats
 
-    starts = bins.starts(per_decade)
-    weight = np.add.reduceat(bins.weight, starts)
-    ratio = np.add.reduceat(bins.count * bins.density, starts) / np.add.reduceat(bins.count * expected, starts)
-    freedom = starts.size - parameters
+    merged = bins.grouped(per_decade)
+    weight = merged.weight
+    ratio = merged.density * merged.count / np.add.reduceat(bins.count * expected, bins.starts(per_decade))
+    freedom = len(merged) - parameters
     if freedom < 1:
         return math.nan
     lower = stats.gamma.cdf(weight * ratio, weight)
@@ -271,13 +271,12 @@ def _fit(bins, exponent_range, noise, rolloff):
     f2 = bins.means["f2"] / bins.means["f2"][-1]
 
     def parts(theta):
-        """The relative power part, its derivative in the exponent and the noise part."""
+        """The relative power part, its log, and the noise part."""
         power = log_power(bins, theta[0])
-        slope = (log_power(bins, theta[0] + 1e-6) - power) / 1e-6
         shape = np.exp(power - power[-1])
         if rolloff:
             shape = shape * np.exp(-f2 * math.exp(-2 * theta[2]))
-        return shape, slope - slope[-1], math.exp(theta[1]) * noise_shape if noise else 0.0
+        return shape, power, math.exp(theta[1]) * noise_shape if noise else 0.0
 
     def nll(theta):
         shape, _, floor = parts(theta)
@@ -285,7 +284,9 @@ def _fit(bins, exponent_range, noise, rolloff):
         return total * math.log(np.sum(weight * density / model) / total) + np.sum(weight * np.log(model))
 
     def nll_and_gradient(theta):
-        shape, slope, floor = parts(theta)
+        shape, power, floor = parts(theta)
+        slope = (log_power(bins, theta[0] + 1e-6) - power) / 1e-6
+        slope = slope - slope[-1]
         model = shape + floor
         ratio = weight * density / model
         level = ratio.sum() / total
@@ -394,16 +395,16 @@ def scaling_range(bins, exponent_range, level=0.01, min_decades=1.0, noise=True,
         passing = []
         for first in range(0, size - width + 1):
             low, high = lowest[first], highest[first + width - 1]
-            if _decades(low, high) < min_decades or width <= 4:
+            if decades(low, high) < min_decades or width <= 4:
                 continue
             part = grid.part(first, first + width)
             fit = fit_spectrum(part, exponent_range, noise, rolloff)
             p = fit.p_value()
             best_p = max(best_p, p if math.isfinite(p) else 0.0)
             span = (low, min(high, fit.crossover()))
-            if p < level or _decades(*span) < min_decades or not power_law_found(fit):
+            if p < level or decades(*span) < min_decades or not power_law_found(fit):
                 continue
-            if _at_bound(fit.exponent, exponent_range):
+            if at_bound(fit.exponent, exponent_range):
                 bound_choice = bound_choice or (first, width)
             else:
                 passing.append((p, first))
@@ -435,7 +436,7 @@ def conclude(fit, exponent_range, best_p, grid):
     frequencies = fit.bins.frequency
     band = (float(frequencies[0]), float(frequencies[-1]))
     span = (band[0], float(min(band[1], max(fit.crossover(), band[0]))))
-    bound = _at_bound(fit.exponent, exponent_range)
+    bound = at_bound(fit.exponent, exponent_range)
     hint = nearest_fractal(grid, exponent_range) if bound else None
     return Scaling(fit, fit.p_value(), band, span, "at bound" if bound else "power law", best_p, hint)
 
@@ -465,9 +466,11 @@ def nearest_fractal(grid, exponent_range, decades=1.0):
     )
 
 
-def _decades(low, high):
+def decades(low, high):
+    """How many decades from ``low`` to ``high`` (0 for an empty or reversed band)."""
     return math.log10(high / low) if high > low > 0 else 0.0
 
 
-def _at_bound(exponent, exponent_range):
+def at_bound(exponent, exponent_range):
+    """Whether a fitted exponent sits on an end of its range (within 1e-3)."""
     return min(abs(exponent - bound) for bound in exponent_range) < 1e-3
