@@ -245,13 +245,20 @@ def history_entry(command, parameters):
 
 
 def timestamp():
-    """Now (or ``SOURCE_DATE_EPOCH``) as an ISO 8601 UTC string to the second."""
+    """Now (or ``SOURCE_DATE_EPOCH``, whole seconds since 1970 UTC) as an ISO 8601 UTC
+    string to the second; an InputError when ``SOURCE_DATE_EPOCH`` is set but is not
+    such a number."""
     epoch = os.environ.get("SOURCE_DATE_EPOCH")
-    moment = (
-        datetime.datetime.fromtimestamp(int(epoch), datetime.timezone.utc)
-        if epoch and epoch.isdigit()
-        else datetime.datetime.now(datetime.timezone.utc)
-    )
+    if not epoch:
+        return datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+    try:
+        if not epoch.strip().isdigit():
+            raise ValueError(epoch)
+        moment = datetime.datetime.fromtimestamp(int(epoch), datetime.timezone.utc)
+    except (ValueError, OverflowError, OSError):
+        raise InputError(
+            f"SOURCE_DATE_EPOCH={epoch!r}: not a time (whole seconds since 1970-01-01 UTC, e.g. 1767225600)"
+        ) from None
     return moment.strftime("%Y-%m-%dT%H:%M:%SZ")
 
 
@@ -290,9 +297,13 @@ def index_range(bound, origin, spacing, count, name):
     start = 0 if low is None else max(0, int(np.floor((low - origin) / spacing + 0.5)))
     stop = count if high is None else min(count, int(np.floor((high - origin) / spacing + 0.5)) + 1)
     if stop - start < 2:
+        from .units import digits_for, format_length
+
         last = origin + spacing * (count - 1)
-        ends = ":".join("" if end is None else f"{end:g}m" for end in bound)
+        digits = digits_for(max(abs(origin), abs(last)), spacing)
+        ends = ":".join("" if end is None else format_length(end, digits).replace(" ", "") for end in bound)
         raise InputError(
-            f"the {name} range {ends} holds fewer than two samples (the data span {origin:g} m to {last:g} m)"
+            f"the {name} range {ends} holds fewer than two samples "
+            f"(the data span {format_length(origin, digits)} to {format_length(last, digits)})"
         )
     return start, stop

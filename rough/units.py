@@ -88,6 +88,18 @@ def format_length(metres, digits=5):
     return format_si(metres, "m", digits)
 
 
+def digits_for(magnitude, resolution):
+    """Significant digits that show ``resolution`` in a number of size ``magnitude``
+    (at least five, at most fifteen): a 1 m step at 564 km needs seven.
+
+    >>> digits_for(564999.0, 1.0), digits_for(0.1, 0.1)
+    (7, 5)
+    """
+    if not (resolution > 0 and math.isfinite(magnitude) and math.isfinite(resolution)) or magnitude == 0:
+        return 5
+    return max(5, min(15, 1 + math.ceil(math.log10(abs(magnitude) / resolution))))
+
+
 def format_si(value, unit, digits=5):
     """``value`` (in the SI ``unit``) printed with a prefix: ``format_si(2.5e-5, 'm')``
     → ``'25 µm'``. Zero, NaN and infinities print in the plain unit."""

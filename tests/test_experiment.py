@@ -286,7 +286,9 @@ def test_analyze_command(study, tmp_path):
     assert "32 from 4 subjects" in table
     assert (tmp_path / "f.png").read_bytes()[:4] == b"\x89PNG"
     rows = rough("experiment", "analyze", study, "--tsv", check=True).stdout.decode().splitlines()
-    assert rows[0] == "name\testimate\tstderr\twald\tp\tunit" and len(rows) == 7
+    estimates = [row.split("\t")[1] for row in rows if row.split("\t")[1].endswith(".estimate")]
+    assert len(estimates) == 6 and "coefficients.rq.estimate" in estimates
+    assert all(row.split("\t")[0] == str(study) for row in rows)
 
 
 def test_observer_specs():

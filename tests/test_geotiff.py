@@ -226,7 +226,7 @@ def test_window_outside_the_raster_is_refused_in_one_line(run):
     with pytest.raises(InputError) as raised:
         rough.read(DEM / "TM1_564_146.tif", crop=((0.0, 10.0), None))
     assert "\n" not in str(raised.value)
-    assert "fewer than two samples" in str(raised.value) and "564000 m to 564999 m" in str(raised.value)
+    assert "fewer than two samples" in str(raised.value) and "564 km to 564.999 km" in str(raised.value)
     result = run("features", "--crop", "0m:10m", DEM / "TM1_564_146.tif")
     assert_one_line_error(result, "fewer than two samples")
 

@@ -78,7 +78,7 @@ def test_table_names_units_and_definitions(rock):
 
 def test_tsv_rows(rock):
     rows = [line.split("\t") for line in rough("features", "--tsv", rock, check=True).stdout.decode().splitlines()]
-    units = {row[0]: row[2] for row in rows}
+    units = {row[1]: row[3] for row in rows}
     assert units["Ra"] == "m" and units["Rsk"] == "1" and units["peak_density"] == "1/m"
 
 

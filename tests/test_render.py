@@ -372,7 +372,7 @@ def test_render_dynamic_realtime_reports_timing():
         rough(
             "render", "--model", "dynamic", "--realtime", "--duration", "0.2s", "--json", input=profile, check=True
         ).stdout
-    )
+    )["runs"][0]
     assert report["ticks"] == 200 and report["rate"] == pytest.approx(1000, rel=0.05)
     assert {"jitter_p50", "jitter_p99", "jitter_max", "missed_deadlines"} <= set(report)
 

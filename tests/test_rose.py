@@ -2,6 +2,7 @@
 
 import json
 import math
+import re
 
 import numpy as np
 import pytest
@@ -101,12 +102,13 @@ def test_rose_command(tmp_path):
         check=True,
     ).stdout
     values = json.loads(rough("rose", "--json", "--plot", tmp_path / "rose.png", input=surface, check=True).stdout)
-    assert {"angles", "fractal_dimension", "amplitude_coefficient", "Str", "Std"} <= set(values)
-    assert values["angles"] == [10.0 * k for k in range(18)]
-    assert len(values["fractal_dimension"]) == len(values["amplitude_coefficient"]) == 18
+    assert {"sectors", "sectors_at_bound", "Str", "Std"} <= set(values)
+    assert [sector["angle"] for sector in values["sectors"]] == [10.0 * k for k in range(18)]
+    assert all({"fractal_dimension", "amplitude_coefficient"} <= set(sector) for sector in values["sectors"])
     assert (tmp_path / "rose.png").read_bytes()[:4] == b"\x89PNG"
     rows = rough("rose", "--tsv", "--step", "30", input=surface, check=True).stdout.decode().splitlines()
-    assert rows[0].startswith("angle_deg\t") and len(rows) == 7
+    angles = [row.split("\t")[2] for row in rows if re.search(r"\tsectors\.\d+\.angle\t", row)]
+    assert angles == ["0.0", "30.0", "60.0", "90.0", "120.0", "150.0"]
     profile = rough("synth", "--length", "5mm", "--dimension", "1.3", "--rq", "0.1mm", "--seed", "1", check=True).stdout
     assert_one_line_error(rough("rose", input=profile), "a rose needs a map")
     assert_one_line_error(rough("rose", "--step", "7", input=surface), "must divide 180")
@@ -123,8 +125,9 @@ def test_rose_command(tmp_path):
 )
 def test_real_files(shared_data, name, extra):
     values = json.loads(rough("rose", "--json", *extra, shared_data / name, check=True).stdout)
-    assert len(values["angles"]) == 18 and all(2.0 <= d <= 3.0 for d in values["fractal_dimension"])
-    assert all(c > 0 for c in values["amplitude_coefficient"])
+    sectors = values["sectors"]
+    assert len(sectors) == 18 and all(2.0 <= sector["fractal_dimension"] <= 3.0 for sector in sectors)
+    assert all(sector["amplitude_coefficient"] > 0 for sector in sectors)
 
 
 def test_x3p2_is_strongly_anisotropic(shared_data):

@@ -226,6 +226,6 @@ def test_render_with_a_fingertip_feels_a_smoother_surface():
     source = rough(
         "synth", "--length", "20mm", "--dimension", "1.275", "--rq", "0.2781mm", "--seed", "1", check=True
     ).stdout
-    bare = json.loads(rough("render", "--json", input=source, check=True).stdout)
-    finger = json.loads(rough("render", "--json", "--tip", "fingertip", input=source, check=True).stdout)
+    bare = json.loads(rough("render", "--json", input=source, check=True).stdout)["runs"][0]
+    finger = json.loads(rough("render", "--json", "--tip", "fingertip", input=source, check=True).stdout)["runs"][0]
     assert finger["F_x_rms"] < bare["F_x_rms"]

@@ -130,7 +130,7 @@ def session(folder, first, second):
         "setup": setup,
         "returncode": rough.returncode,
         "stderr": err,
-        "report": json.loads(out) if out.strip() else None,
+        "report": json.loads(out)["runs"][0] if out.strip() else None,
         "final_force": device.model.force(),
         "effects_left": len(device.model.effects),
         "actuators": device.model.actuators,

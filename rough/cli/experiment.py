@@ -6,7 +6,7 @@ import click
 
 from .haptics import SPEED, TIME, haptic_options
 from .options import LENGTH, plot_option, report_format
-from .report import emit
+from .report import Report, collected_warnings, emit
 
 
 @click.group(short_help="Paired-comparison roughness experiments: design, run sessions, analyze.")
@@ -123,7 +123,7 @@ def design(
         ),
         ("seed", seed, "", str(seed)),
     ]
-    emit(rows, {key: value for key, value, _, _ in rows}, as_json, as_tsv)
+    emit(Report(rows, {key: value for key, value, _, _ in rows}), as_json, as_tsv, study)
 
 
 def _reference(text):
@@ -155,7 +155,13 @@ def _reference(text):
     help="sim: the scripted observer's logistic slopes per mm of Rq and per unit of D, the SD of its "
     "per-subject intercepts, a bias and a seed.",
 )
-@click.option("--speed", type=SPEED, default="60mm/s", show_default=True, help="sim: the hand's stroke speed.")
+@click.option(
+    "--speed",
+    type=SPEED,
+    default="60mm/s",
+    show_default=True,
+    help="sim: the hand's stroke speed (faster than render's 20mm/s: a 1 s stroke must cross a 80 mm surface).",
+)
 @click.option(
     "--stroke", type=TIME, default="1s", show_default=True, help="sim: how long the hand strokes each surface."
 )
@@ -228,7 +234,6 @@ def analyze(study, set_id, plot, as_json, as_tsv):
     W = β/SE and p = 2(1 − Φ(abs(W))), as the paper's Tables 1-2 do, with likelihood-ratio
     tests for D and Rq. Warns under (quasi-)separation, where Wald tests mislead.
     """
-    import logging
 
     from ..experiment.analysis import answers_table, fit
     from ..experiment.design import load_study
@@ -236,38 +241,41 @@ def analyze(study, set_id, plot, as_json, as_tsv):
 
     require("statsmodels")
 
-    loaded = load_study(study)
-    result = fit(answers_table(loaded, set_id), loaded.subjects)
+    with collected_warnings() as warnings:
+        loaded = load_study(study)
+        result = fit(answers_table(loaded, set_id), loaded.subjects)
+        _warn_separation(result)
+    if plot:
+        from .. import plots
+
+        sets = [set_id] if set_id else [s["id"] for s in loaded.sets]
+        plots.save(plots.percentage_figure(loaded, sets, title=str(study)), plot)
+    emit(Report(_table(loaded, result, set_id), result.as_dict()), as_json, as_tsv, study, warnings)
+
+
+def _warn_separation(result):
+    import logging
+
     if result.separation:
         logging.getLogger("rough").warning(
             "(quasi-)separation: some answers are predicted with certainty (e.g. a subject who always chose the same "
             "way), so those Wald statistics are unreliable (Hauck-Donner effect); trust the likelihood-ratio tests"
         )
-    if plot:
-        from .. import plots
-
-        plots.save(plots.percentage_figure(loaded, [set_id] if set_id else [s["id"] for s in loaded.sets]), plot)
-    if as_tsv:
-        click.echo("name\testimate\tstderr\twald\tp\tunit")
-        for name, c in result.coefficients.items():
-            click.echo(f"{name}\t{c['estimate']!r}\t{c['stderr']!r}\t{c['wald']!r}\t{c['p']!r}\t{c['unit']}")
-        return
-    emit(_table(loaded, result, set_id), result.as_dict(), as_json, False)
 
 
 LABELS = {"fractal_dimension": "fractal dimension D", "rq": "Rq (per mm)", "constant": "constant"}
 
 
 def _table(study, result, set_id):
-    rows = [("variable", None, "", f"{'coefficient':>12} {'std. error':>11} {'Wald W':>10} {'p':>11}")]
+    rows = [(None, None, "", f"{'coefficient':>12} {'std. error':>11} {'Wald W':>10} {'p':>11}", "variable")]
     for name, c in result.coefficients.items():
-        label = LABELS.get(name, name.replace("subject_", "subject "))
         rows.append(
             (
-                label,
-                c["estimate"],
-                c["unit"],
+                f"coefficients.{name}",
+                c,
+                {"estimate": c["unit"], "stderr": c["unit"], "wald": "1", "p": "1"},
                 f"{c['estimate']:12.5g} {c['stderr']:11.5g} {c['wald']:10.5g} {_p(c['p']):>11}",
+                LABELS.get(name, name.replace("subject_", "subject ")),
             )
         )
     chosen = [s for s in study.sets if set_id in (None, s["id"])]
@@ -279,26 +287,29 @@ def _table(study, result, set_id):
     ratio = result.likelihood_ratio
     rows += [
         (
-            "answers",
+            "n",
             result.n,
             "1",
             f"{result.n} from {len(result.subjects)} subjects; {scope}; baseline subject {result.subjects[0]}",
+            "answers",
         ),
         (
-            "likelihood ratio",
+            "likelihood_ratio",
             ratio,
-            "",
+            "1",
             (
                 f"D: χ²(1) = {ratio['fractal_dimension']['statistic']:.4g}, p = "
                 f"{_p(ratio['fractal_dimension']['p'])};  "
                 f"Rq: χ²(1) = {ratio['rq']['statistic']:.4g}, p = {_p(ratio['rq']['p'])}"
             ),
+            "likelihood ratio",
         ),
         (
-            "log-likelihood",
+            "log_likelihood",
             result.log_likelihood,
-            "",
+            "1",
             f"{result.log_likelihood:.4f}" + ("" if result.converged else " (not converged)"),
+            "log-likelihood",
         ),
     ]
     return rows

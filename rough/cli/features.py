@@ -4,7 +4,7 @@ slides' feature detection and Rq against evaluation length."""
 import click
 
 from .options import LENGTH, crop_option, plot_option, report_format, surface_input
-from .report import emit, on_stdout
+from .report import Report, on_stdout
 
 
 @click.command(short_help="ISO parameters (Ra…JRC, Sa…Std), amplitude density, feature detection.")
@@ -93,8 +93,6 @@ def features(
     feature_list,
     vs_length,
     plot,
-    as_json,
-    as_tsv,
 ):
     """Parameters of INPUT (default: standard input) computed on the data as given,
     with only the mean of the valid points removed (pipe through `rough detrend`
@@ -125,7 +123,8 @@ def features(
     found = []
     if surface.is_profile:
         found, detection = _detect(evaluated, detect_cutoff, detect_mode, polarity)
-        rows.append(("features", len(found), "", detection["text"]))
+        rows.append(("feature_count", len(found), "1", detection["text"]))
+        document["feature_count"] = len(found)
         document["features"] = [
             {
                 "kind": f.kind,
@@ -151,12 +150,14 @@ def features(
     if plot:
         from .. import plots
 
-        plots.save(plots.features_figure(evaluated, found, (centres, density)), plot)
-    if report:
-        emit(rows, document, as_json, as_tsv)
+        name = "standard input" if input == "-" else input
+        plots.save(plots.features_figure(evaluated, found, (centres, density), title=name), plot)
+    return Report(rows, document) if report else None
 
 
 def _parameter_rows(surface, values, table, cutoff, sampling_lengths, slope, jrc_spacing, along):
+    import logging
+
     import numpy as np
 
     from ..units import format_length, format_quantity
@@ -176,7 +177,8 @@ def _parameter_rows(surface, values, table, cutoff, sampling_lengths, slope, jrc
         "jrc_spacing": jrc_spacing,
         "cutoff": cutoff,
     }
-    rows = [("evaluation", extent, "m", f"{extent}, {valid} of {surface.heights.size} points valid; {basis}")]
+    units = {"points": "points", "valid_points": "points", "size": "m", "jrc_spacing": "m", "cutoff": "m"}
+    rows = [("evaluation", evaluation, units, f"{extent}, {valid} of {surface.heights.size} points valid; {basis}")]
     for key, (unit, meaning) in table.items():
         rows.append((key, values[key], unit, f"{format_quantity(values[key], unit):<14} {meaning}"))
     notes = {
@@ -187,6 +189,9 @@ def _parameter_rows(surface, values, table, cutoff, sampling_lengths, slope, jrc
     }
     if "JRC" in values and not 0 <= values["JRC"] <= 20:
         notes["JRC"] += "; outside the 0–20 range the relation was calibrated on"
+        logging.getLogger("rough").warning(
+            "JRC = %.4g is outside the 0–20 range the Tse–Cruden relation was calibrated on", values["JRC"]
+        )
     rows = [(k, v, u, f"{t} ({notes[k]})" if k in notes else t) for k, v, u, t in rows]
     return rows, {**values, "evaluation": evaluation}
 
@@ -213,16 +218,23 @@ def _scaling_rows(scaling):
 
     key = "Rq" if "Rq" in scaling else "Sq"
     rows = [
-        (f"{key}(L={format_length(length)})", value, "m", f"{format_length(value)} over {count} windows")
-        for length, value, count in zip(scaling["length"], scaling[key], scaling["windows"])
+        (
+            f"rq_vs_length.{key}.{index}",
+            value,
+            "m",
+            f"{format_length(value)} over {count} windows",
+            f"{key}(L={format_length(length)})",
+        )
+        for index, (length, value, count) in enumerate(zip(scaling["length"], scaling[key], scaling["windows"]))
     ]
     rows.append(
         (
-            "scaling",
+            "rq_vs_length.hurst",
             scaling["hurst"],
             "1",
             f"{key} ∝ L^{scaling['hurst']:.3f}: H = {scaling['hurst']:.3f}, D = "
             f"{scaling['fractal_dimension']:.3f} (window means removed)",
+            "scaling",
         )
     )
     return rows

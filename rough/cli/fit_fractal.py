@@ -3,7 +3,7 @@
 import click
 
 from .options import BAND, LENGTH, crop_option, model_options, plot_option, report_format, surface_input
-from .report import emit, on_stdout
+from .report import Report, on_stdout
 
 
 @click.command("fit-fractal", short_help="Fractal dimension D and amplitude coefficient C, with uncertainty.")
@@ -23,7 +23,11 @@ from .report import emit, on_stdout
     help="Whittle likelihood of the spectrum (the estimator), or a cross-check (profiles only).",
 )
 @click.option(
-    "--order", type=click.IntRange(0, 10), default=1, show_default=True, help="Polynomial form removed first."
+    "--order",
+    type=click.IntRange(0, 10),
+    default=1,
+    show_default=True,
+    help="Polynomial form removed first (a plane: the spectrum needs only the tilt gone; detrend's default is 2).",
 )
 @click.option(
     "--sampling",
@@ -56,8 +60,6 @@ def fit_fractal(
     level,
     psd_file,
     plot,
-    as_json,
-    as_tsv,
 ):
     """Fit the power law of INPUT's power spectrum (default: standard input): the
     fractal dimension D (a profile's, 1-2; a map's surface dimension Ds, 2-3, with
@@ -127,12 +129,18 @@ def fit_fractal(
                 np.array(spectrum["density"]),
                 result,
                 surface.spacing,
-                surface.metadata.get("title", "power spectrum"),
+                _title(input, surface),
             ),
             plot,
         )
-    if report:
-        emit(_rows(result, surface, document), document, as_json, as_tsv)
+    return Report(_rows(result, surface, document), document) if report else None
+
+
+def _title(input, surface):
+    """A figure's title: the input's name, and the surface's own title if it has one."""
+    name = "standard input" if input == "-" else input
+    title = surface.metadata.get("title")
+    return f"{name}: {title}" if title else name
 
 
 def _rows(result, surface, document):
@@ -142,10 +150,22 @@ def _rows(result, surface, document):
     if result.verdict == "no power-law range":
         return [
             ("verdict", result.verdict, "", f"no power-law range: {result.hint}"),
+            ("fractal_dimension", None, "1", "none: no band over which the spectrum is a power law"),
             ("p_value", result.p_value, "1", f"{result.p_value:.3g} (the best of any band of a decade)"),
             _method_row(result),
         ]
-    rows = [("fractal_dimension", result.fractal_dimension, "1", _dimension_text(result, key))]
+    rows = [
+        ("verdict", result.verdict, "", result.verdict + (f" ({result.hint})" if result.at_bound else "")),
+        ("fractal_dimension", result.fractal_dimension, "1", _dimension_text(result, key)),
+        (
+            "fractal_dimension_stderr",
+            result.fractal_dimension_stderr,
+            "1",
+            "none: a bound has no standard error"
+            if result.fractal_dimension_stderr is None
+            else f"{result.fractal_dimension_stderr:.4f} (standard error of {key})",
+        ),
+    ]
     if result.profile_dimension is not None:
         rows.append(
             (
@@ -165,6 +185,15 @@ def _rows(result, surface, document):
             "m",
             f"C = {amplitude} at η = {format_length(result.resolution)}",
         ),
+        (
+            "amplitude_coefficient_stderr",
+            result.amplitude_coefficient_stderr,
+            "m",
+            "none: a bound has no standard error"
+            if result.amplitude_coefficient_stderr is None
+            else f"{format_length(result.amplitude_coefficient_stderr)} (standard error of C)",
+        ),
+        ("resolution", result.resolution, "m", f"η = {format_length(result.resolution)} (C is stated at it)"),
         (
             "psd_prefactor",
             result.psd_prefactor,

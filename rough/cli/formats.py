@@ -3,7 +3,7 @@
 import click
 
 from .options import report_format
-from .report import emit
+from .report import Report, emit
 
 
 @click.command(short_help="The file formats rough reads and writes, and what each carries.")
@@ -29,14 +29,15 @@ def formats(as_json, as_tsv):
     extension_width = max(len(" ".join(row["extensions"])) for row in listing)
     rows = [
         (
-            row["name"],
-            "read/write" if row["write"] else "read",
+            f"formats.{index}",
+            row,
             "",
             f"{row['title']:<{title_width}}  {' '.join(row['extensions']):<{extension_width}}  "
             f"{'read/write' if row['write'] else 'read':<10}  "
             + (", ".join(CARRIES[key] for key in row["carries"]) or "heights only")
             + (f"  [needs {row['library']}{'' if row['installed'] else ', not installed'}]" if row["library"] else ""),
+            row["name"],
         )
-        for row in listing
+        for index, row in enumerate(listing)
     ]
-    emit(rows, {"formats": listing}, as_json, as_tsv)
+    emit(Report(rows, {"formats": listing}), as_json, as_tsv)

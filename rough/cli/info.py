@@ -1,17 +1,15 @@
 """rough info: what a surface file holds."""
 
-import json
-
 import click
 
 from .options import report_format, surface_input
-from .report import emit
+from .report import Report
 
 
 @click.command(short_help="Shape, spacing, size, valid points, z range, Rq/Sq and history.")
 @surface_input
 @report_format
-def info(surface, input, as_json, as_tsv):
+def info(surface, input):
     """Describe the surface in INPUT (default: standard input).
 
     Reports the number of points and spacing (x first), the physical size, the
@@ -24,17 +22,18 @@ def info(surface, input, as_json, as_tsv):
         rough info scan.x3p
         rough synth --length 20mm | rough info
         rough info --json scan.x3p | jq .spacing
+        rough info --tsv a.x3p b.x3p c.x3p > inventory.tsv
     """
     from ..io import describe
     from ..summary import summary
     from ..units import format_length
 
     facts = summary(surface)
-    document = {"file": input, "format": surface.source_format, **facts}
+    document = {"format": surface.source_format, **facts}
     x_by_y = " × ".join
     rms_key = "Rq" if surface.is_profile else "Sq"
+    digits = _digits(facts["z_min"], facts["z_max"])
     rows = [
-        ("file", input, "", "standard input" if input == "-" else input),
         ("format", surface.source_format, "", describe(surface.source_format)),
         ("kind", facts["kind"], "", facts["kind"]),
         (
@@ -52,23 +51,30 @@ def info(surface, input, as_json, as_tsv):
             "points",
             f"{facts['valid_points']} of {facts['points']} ({100 * facts['valid_points'] / facts['points']:.2f} %)",
         ),
-        ("z_min", facts["z_min"], "m", _length(facts["z_min"])),
-        ("z_max", facts["z_max"], "m", _length(facts["z_max"])),
+        ("z_min", facts["z_min"], "m", _length(facts["z_min"], digits)),
+        ("z_max", facts["z_max"], "m", _length(facts["z_max"], digits)),
         (rms_key, facts[rms_key], "m", f"{_length(facts[rms_key])} (valid points about their mean, not levelled)"),
-        ("units_in_file", f"{surface.units.xy} {surface.units.z}", "", f"xy {surface.units.xy}, z {surface.units.z}"),
+        ("units", facts["units"], "", f"in the file: xy {surface.units.xy}, z {surface.units.z}"),
     ]
     rows += [(f"metadata.{key}", value, "", value) for key, value in sorted(facts["metadata"].items())]
-    rows += [
-        (f"history.{number}", json.dumps(entry, ensure_ascii=False), "", _history_line(entry))
-        for number, entry in enumerate(facts["history"], 1)
-    ]
-    emit(rows, document, as_json, as_tsv)
+    rows += [(f"history.{number}", entry, "", _history_line(entry)) for number, entry in enumerate(facts["history"])]
+    return Report(rows, document)
 
 
-def _length(value):
+def _length(value, digits=5):
     from ..units import format_length
 
-    return "none (no valid points)" if value is None else format_length(value)
+    return "none (no valid points)" if value is None else format_length(value, digits)
+
+
+def _digits(low, high):
+    """Significant digits that tell ``low`` from ``high`` (a 4 µm range at 106 mm
+    needs eight)."""
+    from ..units import digits_for
+
+    if low is None or high is None:
+        return 5
+    return digits_for(max(abs(low), abs(high)), (high - low) / 100)
 
 
 def _history_line(entry):

@@ -31,6 +31,7 @@ COMMANDS = {
     "fit-fractal": "rough.cli.fit_fractal:fit_fractal",
     "resample": "rough.cli.resample:resample",
     "rose": "rough.cli.rose:rose",
+    "show": "rough.cli.show:show",
     "render": "rough.cli.render:render",
     "experiment": "rough.cli.experiment:experiment",
 }
@@ -39,6 +40,8 @@ log = logging.getLogger("rough")
 # OSErrors that say a name given on the command line is unusable: bad input, status 2
 _BAD_NAME = {errno.ENAMETOOLONG, errno.ELOOP, errno.ENOTDIR, errno.EISDIR, errno.ENOENT, errno.ENXIO}
 _invoked = []
+_debug = [False]
+current_input = []  # the input being worked on, when a command was given several
 
 
 class PipeClosed(Exception):
@@ -82,8 +85,12 @@ class LazyGroup(click.Group):
         if name not in COMMANDS:
             return None
         module, attribute = COMMANDS[name].split(":")
-        _invoked.append(name)
         return getattr(importlib.import_module(module), attribute)
+
+    def resolve_command(self, ctx, args):
+        name, command, rest = super().resolve_command(ctx, args)
+        _invoked.append(name)
+        return name, command, rest
 
 
 @click.group(cls=LazyGroup, context_settings={"help_option_names": ["-h", "--help"]})
@@ -105,12 +112,16 @@ def cli(quiet, verbose, debug):
     Lengths take a unit (0.1545mm, 30.9um, 2e-3m); a bare number is in mm.
     Invalid points are NaN throughout.
     """
+    from .. import progress
+
     level = logging.ERROR if quiet else (logging.WARNING, logging.INFO, logging.DEBUG)[min(verbose, 2)]
     handler = logging.StreamHandler(sys.stderr) if sys.stderr else logging.NullHandler()
     handler.setFormatter(_Formatter())
+    handler.setLevel(level)
     log.handlers[:] = [handler]
-    log.setLevel(level)
+    log.setLevel(min(level, logging.WARNING))  # warnings reach --json's "warnings" even with -q
     log.propagate = False
+    progress.configure(not quiet)
 
 
 def _warn_in_one_line(message, category, filename, lineno, file=None, line=None):
@@ -127,13 +138,21 @@ class _Formatter(logging.Formatter):
 
 
 def _prefix():
-    return f"rough {_invoked[-1]}" if _invoked else "rough"
+    command = f"rough {_invoked[-1]}" if _invoked else "rough"
+    return f"{command}: {current_input[0]}" if current_input else command
 
 
 def main(args=None):
     """Entry point: run the command line and exit with its status."""
     args = sys.argv[1:] if args is None else list(args)
     sys.exit(run(args))
+
+
+def _help():
+    """Bare ``rough``: the overview on standard output, status 0."""
+    with click.Context(cli, info_name="rough", **cli.context_settings) as ctx:
+        click.echo(cli.get_help(ctx))
+    return 0
 
 
 def run(args):
@@ -146,16 +165,14 @@ def run(args):
             if signal.getsignal(signum) == signal.SIG_DFL:  # nohup's SIG_IGN stays
                 previous[signum] = signal.signal(signum, _stop)
     try:
-        return _run(args)
+        return _run(args) if args or "_ROUGH_COMPLETE" in os.environ else _help()
     finally:
         for signum, handler in previous.items():
             signal.signal(signum, handler)
 
 
 def _run(args):
-    from ..errors import RoughError
-
-    debug = "--debug" in args
+    debug = _debug[0] = "--debug" in args
     # numpy's RuntimeWarnings (invalid value, overflow, mean of empty slice) are noise on a
     # command line: rough announces the NaN and infinities it produces itself
     warnings.filterwarnings("ignore", category=RuntimeWarning)
@@ -165,49 +182,50 @@ def _run(args):
         _flush_stdout()
         return result if isinstance(result, int) else 0
     except Stopped as stopped:
-        _say("hung up" if stopped.signum == getattr(signal, "SIGHUP", None) else "terminated")
+        say("hung up" if stopped.signum == getattr(signal, "SIGHUP", None) else "terminated")
         return 128 + stopped.signum
     except click.exceptions.Exit as done:
         return done.exit_code
     except click.UsageError as error:
         command = f" {_invoked[-1]}" if _invoked else ""
-        _say(f"{error.format_message()} (see 'rough{command} --help')")
+        say(f"{error.format_message()} (see 'rough{command} --help')")
         return 2
     except click.ClickException as error:
-        _say(error.format_message())
+        say(error.format_message())
         return error.exit_code
     except (click.Abort, KeyboardInterrupt, Interrupted):
-        _say("interrupted")
+        say("interrupted")
         return 130
     except (PipeClosed, BrokenPipeError):
         _silence_stdout()
         return 141
-    except RoughError as error:
-        _report(error, debug)
-        return error.exit_code
-    except MemoryError as error:
-        _report(
-            error, debug, "out of memory: the surface is too large for this machine (crop it, or resample it coarser)"
-        )
-        return 1
-    except OSError as error:
-        where = f"{error.filename}: " if error.filename else ""
-        _report(error, debug, f"{where}{error.strerror or error}")
-        return 2 if error.filename and error.errno in _BAD_NAME else 1
     except Exception as error:  # noqa: BLE001 -- the last resort: say what failed, in one line
-        _report(error, debug, f"internal error: {type(error).__name__}: {error} (run with --debug for details)")
-        return 1
+        message, status = failure(error, debug)
+        say(message)
+        return status
 
 
-def _report(error, debug, message=None):
-    if debug:
+def failure(error, debug=None):
+    """``(message, exit status)`` for an exception that ends a command (or, with several
+    inputs, one input's work); with ``debug`` the traceback goes to standard error."""
+    from ..errors import RoughError
+
+    if _debug[0] if debug is None else debug:
         import traceback
 
         traceback.print_exception(error, file=sys.stderr)
-    _say(message or str(error))
+    if isinstance(error, RoughError):
+        return str(error), error.exit_code
+    if isinstance(error, MemoryError):
+        return "out of memory: the surface is too large for this machine (crop it, or resample it coarser)", 1
+    if isinstance(error, OSError):
+        where = f"{error.filename}: " if error.filename else ""
+        return f"{where}{error.strerror or error}", 2 if error.filename and error.errno in _BAD_NAME else 1
+    return f"internal error: {type(error).__name__}: {error} (run with --debug for details)", 1
 
 
-def _say(message):
+def say(message):
+    """Print ``rough COMMAND: message`` on standard error."""
     from .report import printable
 
     if sys.stderr is None:  # closed: the message is lost, but never sent to standard output

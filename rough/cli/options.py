@@ -1,10 +1,11 @@
 """Options shared by the subcommands, as decorators (in the manner of rasterio's rio).
 
-``surface_input`` adds INPUT (default ``-``) and the read options and hands the
-command a :class:`~rough.Surface` (``input_options(flag)`` names the input-spacing
-option otherwise, for commands whose own ``--spacing`` is an output); ``surface_output`` adds ``-o/--output`` and
-``-f/--format`` and hands it an :class:`Output` that writes a surface there; ``report_format``
-adds ``--json``/``--tsv``. Lengths take a unit; a bare number is in mm.
+``surface_input`` adds INPUT… (default ``-``) and the read options and calls the
+command once per input with a :class:`~rough.Surface` (``input_options(flag)`` names
+the input-spacing option otherwise, for commands whose own ``--spacing`` is an
+output); ``surface_output`` adds ``-o/--output`` and ``-f/--format`` and hands it an
+:class:`Output` that writes a surface there; ``report_format`` adds
+``--json``/``--tsv``. Lengths take a unit; a bare number is in mm.
 """
 
 import dataclasses
@@ -43,6 +44,16 @@ class LengthType(click.ParamType):
             return parse_length(value)
         except InputError as error:
             self.fail(str(error), param, ctx)
+
+
+class PositiveLengthType(LengthType):
+    """A length that must be positive (a spacing, cut-off, size, resolution …)."""
+
+    def convert(self, value, param, ctx):
+        length = super().convert(value, param, ctx)
+        if not length > 0:
+            self.fail(f"{value!r}: must be a positive length", param, ctx)
+        return length
 
 
 class SpacingType(LengthType):
@@ -88,6 +99,11 @@ class TipType(LengthType):
 
     name = "RADIUS|needle|fingernail|fingertip"
 
+    def shell_complete(self, ctx, param, incomplete):
+        from click.shell_completion import CompletionItem
+
+        return [CompletionItem(name) for name in ("needle", "fingernail", "fingertip") if name.startswith(incomplete)]
+
     def convert(self, value, param, ctx):
         from ..metrology.tip import PRESETS
 
@@ -112,7 +128,10 @@ class CropType(click.ParamType):
             ends = part.split(":")
             if len(ends) != 2:
                 self.fail(f"{value!r}: write a range as X0:X1, e.g. 468um:733um (an empty end is open)", param, ctx)
-            ranges.append(tuple(None if not end.strip() else LENGTH.convert(end, param, ctx) for end in ends))
+            low, high = (None if not end.strip() else POSITION.convert(end, param, ctx) for end in ends)
+            if low is not None and high is not None and low >= high:
+                self.fail(f"{value!r}: the range {part} ends before it starts (give X0 < X1)", param, ctx)
+            ranges.append((low, high))
         if len(ranges) > 2:
             self.fail(f"{value!r}: at most two ranges, X0:X1,Y0:Y1", param, ctx)
         return (ranges + [None])[:2]
@@ -134,12 +153,18 @@ class FrequencyRangeType(click.ParamType):
         if len(ends) != 2:
             self.fail(f"{value!r}: write a band as FMIN:FMAX, e.g. 0.1/mm:20/mm", param, ctx)
         try:
-            return tuple(None if not end.strip() else parse_frequency(end) for end in ends)
+            low, high = (None if not end.strip() else parse_frequency(end) for end in ends)
         except InputError as error:
             self.fail(str(error), param, ctx)
+        if any(end is not None and end <= 0 for end in (low, high)):
+            self.fail(f"{value!r}: frequencies must be positive", param, ctx)
+        if low is not None and high is not None and low >= high:
+            self.fail(f"{value!r}: FMIN must be below FMAX, e.g. 0.05/mm:5/mm", param, ctx)
+        return low, high
 
 
-LENGTH = LengthType()
+POSITION = LengthType()
+LENGTH = PositiveLengthType()
 TIP = TipType()
 SPACING = SpacingType()
 CROP = CropType()
@@ -203,62 +228,52 @@ class RegridType(SpacingType):
         return spacing, method
 
 
-def input_options(spacing_flag="--spacing", most=1):
-    """INPUT plus ``--spacing`` (under ``spacing_flag``), ``--unit`` and
-    ``--ignore-checksums``; the command receives ``surface`` (the surface read) and
-    ``input`` (the name given). With ``most`` > 1 the command takes up to that many
-    inputs (default ``-``) and receives the lists ``surfaces`` and ``inputs``."""
+def input_options(spacing_flag="--spacing", together=None):
+    """INPUT… plus ``--spacing`` (under ``spacing_flag``), ``--unit``,
+    ``--ignore-checksums``, ``--channel``, ``--layer`` and ``--regrid``. The command
+    is called once per input with ``surface`` (the surface read) and ``input`` (the
+    name given), and returns a :class:`~rough.cli.report.Report` or None (see
+    :mod:`rough.cli.batch`). With ``together`` = N it takes up to N inputs at once
+    instead, as the lists ``surfaces`` and ``inputs``."""
 
     def decorate(command):
         @functools.wraps(command)
         def wrapper(*args, input, spacing, unit, ignore_checksums, channel, layer, regrid, **kwargs):
-            from ..errors import InputError
-            from ..io import read
+            from .batch import read_named, run_each
 
-            names = (input or ("-",)) if most > 1 else (input,)
-            if len(names) > most:
-                raise click.UsageError(f"give at most {most} inputs, not {len(names)}")
-            if "-" in names and sys.stdin is None:
-                raise InputError("<stdin>: standard input is closed")
-            crop = kwargs.pop("crop", None)
-            surfaces = [
-                read(
-                    name,
-                    spacing=spacing,
-                    unit=unit,
-                    verify=not ignore_checksums,
-                    channel=channel,
-                    layer=layer,
-                    crop=crop,
-                    regrid=regrid,
-                )
-                for name in names
-            ]
-            try:
-                if most > 1:
-                    return command(*args, surfaces=surfaces, inputs=list(names), **kwargs)
-                return command(*args, surface=surfaces[0], input=input, **kwargs)
-            except InputError as error:
-                shown = "<stdin>" if names[0] == "-" else names[0]
-                if len(names) > 1 or error.filename is not None or str(error).startswith(f"{shown}: "):
-                    raise
-                raise type(error)(f"{shown}: {error}") from error
+            options = dict(
+                spacing=spacing,
+                unit=unit,
+                verify=not ignore_checksums,
+                channel=channel,
+                layer=layer,
+                crop=kwargs.pop("crop", None),
+                regrid=regrid,
+            )
+            if "output" in kwargs:  # surface_output's, made an Output here to name one per input
+                kwargs["output"] = Output(kwargs.pop("output"), kwargs.pop("format"))
+            names = list(input or ("-",))
+            if together:
+                return _together(functools.partial(command, *args), names, options, together, kwargs)
 
-        argument = (
-            click.argument("input", nargs=-1, metavar=f"[INPUT]{' [INPUT]' * (most - 1)}")
-            if most > 1
-            else click.argument("input", default="-", metavar="[INPUT]")
-        )
+            def work(name, **rest):
+                return command(*args, surface=read_named(name, options), input=name, **rest)
+
+            return run_each(work, names, kwargs)
+
+        paths = click.Path(dir_okay=False, allow_dash=True)
         decorators = [
-            argument,
+            click.argument("input", nargs=-1, type=paths, metavar="[INPUT]..."),
             click.option(
                 spacing_flag,
                 "spacing",
                 type=SPACING,
                 help="Spacing of input data that carry none (NPY, a column of heights), e.g. 1um or "
-                "1um,2um; overrides a file's own.",
+                "1um,2um; overrides a file's own, with a warning.",
             ),
-            click.option("--unit", metavar="UNIT", help="Length unit of text values that name none (default m)."),
+            click.option(
+                "--unit", metavar="UNIT", help="Length unit of text values that name none (default m, not mm)."
+            ),
             click.option(
                 "--ignore-checksums", is_flag=True, help="Read X3P files whose MD5 checksums fail, with a warning."
             ),
@@ -285,6 +300,21 @@ def input_options(spacing_flag="--spacing", most=1):
     return decorate
 
 
+def _together(command, names, options, most, kwargs):
+    """Inputs that one run uses together (render's surfaces, switched by the trigger):
+    one report, under the first input's name."""
+    from .batch import check_inputs, read_named, run_each
+
+    if len(names) > most:
+        raise click.UsageError(f"give at most {most} inputs, not {len(names)}")
+    check_inputs(names)
+
+    def work(name, **rest):
+        return command(surfaces=[read_named(each, options) for each in names], inputs=names, **rest)
+
+    return run_each(work, names[:1], kwargs)
+
+
 surface_input = input_options()
 
 
@@ -307,8 +337,8 @@ def surface_output(command):
     ``output``, an :class:`Output`."""
 
     @functools.wraps(command)
-    def wrapper(*args, output, format, **kwargs):
-        return command(*args, output=Output(output, format), **kwargs)
+    def wrapper(*args, output, format=None, **kwargs):
+        return command(*args, output=output if isinstance(output, Output) else Output(output, format), **kwargs)
 
     wrapper = click.option(
         "-f",
@@ -321,20 +351,57 @@ def surface_output(command):
         "-o",
         "--output",
         default="-",
-        metavar="FILE",
+        type=click.Path(allow_dash=True),
+        metavar="FILE|DIR/",
         show_default=True,
-        help="Output file, written atomically; - is standard output.",
+        help="Output file, written atomically; - is standard output; with several inputs a directory.",
     )(wrapper)
     return wrapper
 
 
 @dataclasses.dataclass(frozen=True)
 class Output:
-    """Where a command's surface goes: a file (written atomically) or standard output
-    (X3P unless told otherwise; binary output to a terminal is refused)."""
+    """Where a command's surface goes: a file (written atomically), standard output
+    (X3P unless told otherwise; binary output to a terminal is refused), or, for
+    several inputs, a directory (``out/``) where each keeps its name with the output
+    format's extension."""
 
     path: str = "-"
     requested_format: str = None
+
+    @property
+    def is_directory(self):
+        import os
+
+        return self.path != "-" and (self.path.endswith(os.sep) or os.path.isdir(self.path))
+
+    def check_directory(self, names):
+        """With several inputs: ``-o`` must be a directory, and no two inputs may land
+        on the same output file."""
+        if not self.is_directory:
+            raise click.UsageError("with several inputs, -o names a directory (e.g. -o out/)")
+        targets = [self.for_input(name).path for name in names]
+        clash = next((target for target in targets if targets.count(target) > 1), None)
+        if clash is not None:
+            raise click.UsageError(f"two inputs would both be written to {clash}")
+
+    def for_input(self, name):
+        """The output of input ``name``: in the directory, the input's stem with the
+        output format's extension; otherwise this output itself."""
+        import os
+
+        from ..errors import InputError
+        from ..io.registry import formats
+        from .batch import stem_name
+
+        if not self.is_directory:
+            return self
+        if name == "-":
+            raise InputError("standard input has no name to write under: give -o FILE", filename=self.path)
+        os.makedirs(self.path, exist_ok=True)
+        format_name = self.requested_format or "x3p"
+        extension = formats()[format_name].extensions[0]
+        return Output(os.path.join(self.path, stem_name("{stem}", name) + extension), format_name)
 
     @property
     def format(self):
@@ -367,6 +434,11 @@ class Output:
 
 
 def report_format(command):
-    """``--json`` (one JSON object, SI units) and ``--tsv`` (key, value, unit rows)."""
-    command = click.option("--tsv", "as_tsv", is_flag=True, help="Print tab-separated rows: key, value, unit.")(command)
-    return click.option("--json", "as_json", is_flag=True, help="Print one JSON object (SI units).")(command)
+    """``--json`` (one JSON object, SI units) and ``--tsv`` (file, key, value, unit rows):
+    the output contract of :mod:`rough.cli.report`."""
+    command = click.option(
+        "--tsv", "as_tsv", is_flag=True, help="Print tab-separated rows: file, key, value, unit (SI units, no header)."
+    )(command)
+    return click.option(
+        "--json", "as_json", is_flag=True, help="Print one JSON object (SI units); several inputs: JSON Lines."
+    )(command)

@@ -3,12 +3,12 @@
 import click
 
 from .haptics import DAMPING, FORCE, MASS, SPEED, STIFFNESS, TIME, haptic_options
-from .options import CROP, LENGTH, TIP, input_options, plot_option, report_format
-from .report import emit, on_stdout
+from .options import CROP, POSITION, TIP, input_options, plot_option, report_format
+from .report import Report, on_stdout
 
 
 @click.command(short_help="The haptic contact loop on a USB force-feedback joystick or a simulated hand.")
-@input_options(most=2)
+@input_options(together=2)
 @haptic_options
 @click.option(
     "--speed",
@@ -16,7 +16,8 @@ from .report import emit, on_stdout
     type=SPEED,
     multiple=True,
     metavar="SPEED",
-    help="sim: stroke speed (default 20mm/s; repeat for several runs, e.g. --speed 20mm/s --speed 120mm/s).",
+    help="sim: stroke speed (default 20mm/s, slow enough to feel each feature; experiment run strokes at "
+    "60mm/s; repeat for several runs, e.g. --speed 20mm/s --speed 120mm/s). A bare number is in mm/s.",
 )
 @click.option("--duration", type=TIME, help="Run length (default: sim one pass over the window; hid until Ctrl-C).")
 @click.option("--press", type=FORCE, default="1N", show_default=True, help="sim: the hand's downward push.")
@@ -30,7 +31,7 @@ from .report import emit, on_stdout
 @click.option(
     "--realtime", is_flag=True, help="sim: pace the loop in real time (as a joystick is) instead of running flat out."
 )
-@click.option("--row", type=LENGTH, help="Maps: render the row at this y position (default the middle row).")
+@click.option("--row", type=POSITION, help="Maps: render the row at this y position (default the middle row).")
 @click.option(
     "--crop", "window", type=CROP, help="The profile window X0:X1 to render (lengths; positions include the origin)."
 )
@@ -65,8 +66,6 @@ def render(
     tip,
     trace,
     plot,
-    as_json,
-    as_tsv,
 ):
     """Run the haptic contact loop on the profile INPUT (default: standard input): a
     virtual stylus rides the profile and the contact force (F_y = K·penetration,
@@ -121,13 +120,11 @@ def render(
         )
     else:
         runs = [run_hid(haptics.device, tracks, contact, friction, settings, haptics.stick_span, haptics.invert)]
-    _outputs(runs, trace, plot)
-    rows, document = summary_rows(runs, haptics.model, contact, haptics.friction)
-    if report:
-        emit(rows, document, as_json, as_tsv)
+    _outputs(runs, trace, plot, "standard input" if inputs[0] == "-" else inputs[0])
+    return Report(*summary_rows(runs, haptics.model, contact, haptics.friction)) if report else None
 
 
-def _outputs(runs, trace, plot):
+def _outputs(runs, trace, plot, title):
     from ..render import write_trace
 
     if trace:
@@ -136,4 +133,4 @@ def _outputs(runs, trace, plot):
     if plot:
         from .. import plots
 
-        plots.save(plots.force_figure(runs), plot)
+        plots.save(plots.force_figure(runs, title=title), plot)

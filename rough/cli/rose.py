@@ -3,7 +3,7 @@
 import click
 
 from .options import BAND, LENGTH, crop_option, model_options, plot_option, report_format, surface_input
-from .report import echo, emit, on_stdout
+from .report import Report, on_stdout
 
 
 @click.command(short_help="D(θ) and C(θ) by direction for maps (the amplitude coefficient rose); Str, Std.")
@@ -24,16 +24,18 @@ from .report import echo, emit, on_stdout
 @click.option("--band", type=BAND, help="Fit band FMIN:FMAX in cycles per length (bare numbers per mm).")
 @click.option("--resolution", type=LENGTH, help="The resolution η at which C is stated (default: the smaller spacing).")
 @click.option(
-    "--order", type=click.IntRange(0, 10), default=1, show_default=True, help="Polynomial form removed first."
+    "--order",
+    type=click.IntRange(0, 10),
+    default=1,
+    show_default=True,
+    help="Polynomial form removed first (a plane: the spectrum needs only the tilt gone; detrend's default is 2).",
 )
 @click.option("--sampling", type=click.Choice(["point", "band-limited"]), help="As for fit-fractal.")
 @click.option("--fill", is_flag=True, help="Fill invalid points first (biharmonic inpainting).")
 @model_options
 @plot_option("Draw polar roses of C(θ) and D(θ), mirrored to 360°; - is standard output, instead of the report.")
 @report_format
-def rose(
-    surface, input, step, width, band, resolution, order, sampling, fill, noise, rolloff, level, plot, as_json, as_tsv
-):
+def rose(surface, input, step, width, band, resolution, order, sampling, fill, noise, rolloff, level, plot):
     """Fit the surface dimension Ds(θ) and amplitude coefficient C(θ) of the map
     INPUT (default: standard input) in direction sectors of its Hann-windowed 2-D
     power spectrum, with the axis lines, where a map's edges leak, left out. θ is the
@@ -73,29 +75,8 @@ def rose(
     if plot:
         from .. import plots
 
-        plots.save(plots.rose_figure(result, surface.metadata.get("title", "direction dependence")), plot)
-    if on_stdout(plot=plot):
-        return
-    if as_tsv:
-        _print_tsv(result)
-        return
-    emit(_rows(result), result.as_dict(), as_json, False)
-
-
-def _print_tsv(result):
-    echo(
-        "angle_deg\tfractal_dimension\tfractal_dimension_stderr\tamplitude_coefficient_m"
-        "\tamplitude_coefficient_stderr_m\tat_bound"
-    )
-    for *row, bound in zip(
-        result.angles,
-        result.fractal_dimension,
-        result.fractal_dimension_stderr,
-        result.amplitude_coefficient,
-        result.amplitude_coefficient_stderr,
-        result.at_bound,
-    ):
-        echo("\t".join(["" if value is None else repr(float(value)) for value in row] + [str(bound).lower()]))
+        plots.save(plots.rose_figure(result, "standard input" if input == "-" else input), plot)
+    return None if on_stdout(plot=plot) else Report(_rows(result), result.as_dict())
 
 
 def _sector_text(dimension, dimension_error, amplitude, amplitude_error):
@@ -107,56 +88,75 @@ def _sector_text(dimension, dimension_error, amplitude, amplitude_error):
     return f"Ds = {dimension:.4f} ± {dimension_error:.4f}   C = {spread}"
 
 
+SECTOR_UNITS = {
+    "angle": "deg",
+    "fractal_dimension": "1",
+    "fractal_dimension_stderr": "1",
+    "amplitude_coefficient": "m",
+    "amplitude_coefficient_stderr": "m",
+    "noise_rms": "m",
+}
+FIT_UNITS = {
+    "dimension": "1",
+    "dimension_error": "1",
+    "amplitude": "m",
+    "amplitude_error": "m",
+    "frequencies_used": "1",
+}
+LAY_UNITS = {"direction": "deg", "wavelength": "m"}
+
+
+def _fit_text(fit):
+    return _sector_text(fit["dimension"], fit["dimension_error"], fit["amplitude"], fit["amplitude_error"])
+
+
 def _rows(result):
     from ..units import format_length, format_quantity
 
+    document = result.as_dict()
     rows = [
-        (f"θ = {angle:5.1f}°", [d, c], "", _sector_text(d, de, c, ce))
-        for angle, d, de, c, ce in zip(
-            result.angles,
-            result.fractal_dimension,
-            result.fractal_dimension_stderr,
-            result.amplitude_coefficient,
-            result.amplitude_coefficient_stderr,
+        (
+            f"sectors.{index}",
+            sector,
+            SECTOR_UNITS,
+            _sector_text(
+                sector["fractal_dimension"],
+                sector["fractal_dimension_stderr"],
+                sector["amplitude_coefficient"],
+                sector["amplitude_coefficient_stderr"],
+            ),
+            f"θ = {sector['angle']:5.1f}°",
         )
+        for index, sector in enumerate(document["sectors"])
     ]
-    principal, across = result.principal, result.perpendicular
     isotropy = result.isotropy_p_value
     long_lay, fine_lay = result.lay["long_wavelength"], result.lay["resolution"]
-    bound = sum(result.at_bound)
+    bound = document["sectors_at_bound"]
     rows += [
         (
-            "principal",
+            "principal_direction",
             result.principal_direction,
             "deg",
-            f"{result.principal_direction:.1f}° (largest C of the rose's cos 2θ part): "
-            + _sector_text(
-                principal["dimension"],
-                principal["dimension_error"],
-                principal["amplitude"],
-                principal["amplitude_error"],
-            ),
+            f"{result.principal_direction:.1f}° (largest C of the rose's cos 2θ part)",
         ),
+        ("principal", result.principal, FIT_UNITS, f"along θp: {_fit_text(result.principal)}"),
         (
             "perpendicular",
-            (result.principal_direction + 90) % 180,
-            "deg",
-            f"{(result.principal_direction + 90) % 180:.1f}°: "
-            + _sector_text(
-                across["dimension"], across["dimension_error"], across["amplitude"], across["amplitude_error"]
-            ),
+            result.perpendicular,
+            FIT_UNITS,
+            f"across, at {(result.principal_direction + 90) % 180:.1f}°: {_fit_text(result.perpendicular)}",
         ),
         (
-            "lay_long_wavelength",
-            long_lay["direction"],
-            "deg",
+            "lay.long_wavelength",
+            long_lay,
+            LAY_UNITS,
             f"{long_lay['direction']:.1f}° (ridges at wavelength {format_length(long_lay['wavelength'])}, the band's "
             "long end: on a fault, the slip direction)",
         ),
         (
-            "lay_resolution",
-            fine_lay["direction"],
-            "deg",
+            "lay.resolution",
+            fine_lay,
+            LAY_UNITS,
             f"{fine_lay['direction']:.1f}° (ridges at η = {format_length(fine_lay['wavelength'])}, the finest texture)",
         ),
         (
@@ -165,11 +165,16 @@ def _rows(result):
             "deg",
             f"{result.largest_sector:.1f}° (the sector with the largest C)",
         ),
-        ("at_bound", bound, "1", f"{bound} of {len(result.angles)} sectors have Ds at a bound (left out of the tests)"),
         (
-            "isotropy",
+            "sectors_at_bound",
+            bound,
+            "1",
+            f"{bound} of {len(result.angles)} sectors have Ds at a bound (left out of the tests)",
+        ),
+        (
+            "isotropy_p_value",
             isotropy,
-            "",
+            "1",
             "not tested (overlapping sectors, or fewer than two sectors inside the range)"
             if isotropy["fractal_dimension"] is None
             else f"χ² p-values: Ds flat {isotropy['fractal_dimension']:.3g}, "

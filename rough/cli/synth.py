@@ -138,6 +138,12 @@ def synth(
         if anisotropy is not None:
             raise InputError("--anisotropy needs a map (--size)")
         count = points if points is not None else round(length / spacing)
+        if count < 2:
+            from ..units import format_length
+
+            raise InputError(
+                f"--length {format_length(length)} holds fewer than two samples at the spacing {format_length(spacing)}"
+            )
         if fragments:
             if rolloff is not None:
                 raise InputError("--rolloff does not apply to the paper's fragments")

@@ -170,23 +170,42 @@ def run_session(study, subject, present, device_name):
         answers = read_answers(study, subject)
         saved = len(answers)
         done = {int(row["trial"]) for row in answers}
-        for trial in trials:
-            if trial["trial"] in done:
-                continue
-            outcome = present(trial)
-            if outcome is None:
-                break
-            answers.append(_answer_row(study, trial, *outcome, device_name))
-            _save(study, subject, answers)
-            saved = len(answers)
-        else:
-            return Progress(saved, len(trials) - saved, len(trials))
+        with _trials_bar(subject, len(trials) - saved, device_name) as bar:
+            for trial in trials:
+                if trial["trial"] in done:
+                    continue
+                outcome = present(trial)
+                if outcome is None:
+                    break
+                answers.append(_answer_row(study, trial, *outcome, device_name))
+                _save(study, subject, answers)
+                saved = len(answers)
+                bar.update()
+            else:
+                return Progress(saved, len(trials) - saved, len(trials))
     except KeyboardInterrupt:
         try:
             saved = len(read_answers(study, subject))
         except (KeyboardInterrupt, InputError):
             pass
     return Progress(saved, len(trials) - saved, len(trials), interrupted=True)
+
+
+def _trials_bar(subject, count, device_name):
+    """A progress bar over the simulated hand's trials (none on a joystick, whose
+    subject needs the terminal quiet)."""
+    import contextlib
+
+    from ..progress import progress
+
+    if device_name != "sim":
+        return contextlib.nullcontext(_NoBar())
+    return progress(total=count, description=f"{subject}: trials", unit="trial")
+
+
+class _NoBar:
+    def update(self, n=1):
+        pass
 
 
 def _answer_row(study, trial, answer, seconds, toggles, device_name):

@@ -33,6 +33,17 @@ from .psd import sector_spectra, windowed_map
 log = logging.getLogger("rough")
 
 
+#: The fields of :class:`Rose` that hold one value per sector.
+SECTOR_FIELDS = (
+    "fractal_dimension",
+    "fractal_dimension_stderr",
+    "amplitude_coefficient",
+    "amplitude_coefficient_stderr",
+    "at_bound",
+    "noise_rms",
+)
+
+
 @dataclasses.dataclass
 class Rose:
     """The result of :func:`rose`: per-sector Ds and C with standard errors, and the
@@ -105,7 +116,9 @@ class Rose:
 
     Notes
     -----
-    ``as_dict()`` gives the fields as a JSON-able dict (``band`` as a list).
+    ``as_dict()`` gives the fields as a JSON-able dict: the per-sector lists as
+    ``sectors``, one dict per sector (``angle`` and the fields below it), with
+    ``sectors_at_bound`` counting those at a bound, and ``band`` as a list.
 
     Examples
     --------
@@ -144,8 +157,11 @@ class Rose:
 
     def as_dict(self):
         values = dataclasses.asdict(self)
-        values["band"] = list(self.band)
-        return values
+        sectors = [{"angle": angle} for angle in values.pop("angles")]
+        for field in SECTOR_FIELDS:
+            for sector, value in zip(sectors, values.pop(field)):
+                sector[field] = value
+        return {"sectors": sectors, "sectors_at_bound": sum(self.at_bound), **values, "band": list(self.band)}
 
 
 def rose(
@@ -244,36 +260,52 @@ def rose(
     frequency_step, low, high = map_band(surface, band, sampling)
     from scipy import fft
 
+    from ..progress import progress
     from .scaling import ring_bins
 
-    field, power = windowed_map(surface, order)
-    refuse_flat(field, surface.heights)
-    transform = fft.rfft2(field, workers=-1)
+    log.info(
+        f"{round(180 / step)} sectors {width:g}° wide over a {surface.heights.shape[1]} × "
+        f"{surface.heights.shape[0]} map"
+    )
+    with progress(total=6, description="rose", unit="stage") as bar:
+        field, power = windowed_map(surface, order)
+        refuse_flat(field, surface.heights)
+        transform = fft.rfft2(field, workers=-1)
+        bar.update()
 
-    def spectra(low, high, sectors):
-        return sector_spectra(field, power, surface.spacing, low, high, frequency_step, sectors, transform=transform)
+        def spectra(low, high, sectors):
+            return sector_spectra(
+                field, power, surface.spacing, low, high, frequency_step, sectors, transform=transform
+            )
 
-    whole = spectra(low, high, None)[0]
-    _enough(whole)
-    outcome = band_outcome(ring_bins(whole, surface.spacing), MAP_RANGE, band, options)
-    low, high = outcome.band or (low, high)
-    count = round(180 / step)
-    sectors = spectra(low * (1 - 1e-9), high * (1 + 1e-9), (0.0, math.radians(step), count, math.radians(width)))
-    fits = [_sector_fit(rings, surface.spacing, resolution, options) for rings in sectors]
-    bound = [fit["at_bound"] for fit in fits]
-    if any(bound):
-        log.warning(f"Ds is at the edge of the fractal range (a bound) in {sum(bound)} of {count} sectors")
-    angles = [k * step for k in range(count)]
-    usable = [fit for fit in fits if not fit["at_bound"]]
-    usable_angles = [angle for angle, fit in zip(angles, fits) if not fit["at_bound"]]
-    if len(usable) < 3:
-        usable, usable_angles = fits, angles
-    principal = _principal_direction(usable_angles, [_level(fit, 1 / resolution) for fit in usable])
-    along = spectra(low * (1 - 1e-9), high * (1 + 1e-9), (math.radians(principal), math.pi / 2, 2, math.radians(width)))
-    long_end = _principal_direction(usable_angles, [_level(fit, low) for fit in usable])
-    field = transform = None  # free the spectrum before Str and Std
-    levelled = detrend(surface, order=order)
-    str_ratio = autocorrelation_lengths(levelled)[1]
+        whole = spectra(low, high, None)[0]
+        _enough(whole)
+        outcome = band_outcome(ring_bins(whole, surface.spacing), MAP_RANGE, band, options)
+        low, high = outcome.band or (low, high)
+        bar.update()
+        count = round(180 / step)
+        sectors = spectra(low * (1 - 1e-9), high * (1 + 1e-9), (0.0, math.radians(step), count, math.radians(width)))
+        bar.update()
+        fits = [_sector_fit(rings, surface.spacing, resolution, options) for rings in sectors]
+        bound = [fit["at_bound"] for fit in fits]
+        if any(bound):
+            log.warning(f"Ds is at the edge of the fractal range (a bound) in {sum(bound)} of {count} sectors")
+        angles = [k * step for k in range(count)]
+        usable = [fit for fit in fits if not fit["at_bound"]]
+        usable_angles = [angle for angle, fit in zip(angles, fits) if not fit["at_bound"]]
+        if len(usable) < 3:
+            usable, usable_angles = fits, angles
+        principal = _principal_direction(usable_angles, [_level(fit, 1 / resolution) for fit in usable])
+        along = spectra(
+            low * (1 - 1e-9), high * (1 + 1e-9), (math.radians(principal), math.pi / 2, 2, math.radians(width))
+        )
+        long_end = _principal_direction(usable_angles, [_level(fit, low) for fit in usable])
+        field = transform = None  # free the spectrum before Str and Std
+        bar.update()
+        levelled = detrend(surface, order=order)
+        str_ratio = autocorrelation_lengths(levelled)[1]
+        bar.update()
+        std = texture_direction(levelled)
     return Rose(
         angles=angles,
         fractal_dimension=[f["dimension"] for f in fits],
@@ -292,7 +324,7 @@ def rose(
         perpendicular=_summary(_sector_fit(along[1], surface.spacing, resolution, options)),
         isotropy_p_value=_flatness([fit for fit in fits if not fit["at_bound"]], width <= step + 1e-9),
         Str=str_ratio,
-        Std=texture_direction(levelled),
+        Std=std,
         band=(float(low), float(high)),
         verdict=outcome.verdict,
         p_value=outcome.p_value,

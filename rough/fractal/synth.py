@@ -1,7 +1,8 @@
 """Fractal surfaces by spectral synthesis in one transform (docs/math.rst §2.2-2.3).
 
 The whole length (or area) is made in one inverse FFT (maps in single precision,
-profiles in double): the coefficients are those of
+profiles in double; a map's is done in blocks of columns, then rows, bit for bit
+scipy's irfft2, so that Ctrl-C stops it within a block): the coefficients are those of
 the FFT of white Gaussian noise (independent Gaussian real and imaginary parts; the
 k = 0 term zero; the Nyquist terms real), shaped by the square root of the target
 spectrum, so that for a profile ``E[Rq²] = Σ G(f_k)/L + G(f_N)/(2L)`` exactly and for
@@ -27,11 +28,13 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 
 from ..errors import InputError
+from ..progress import progress
 from ..surface import Surface, Units, check_size
 from . import model
 
 log = logging.getLogger("rough")
 ROWS_PER_BLOCK = 256
+POINTS_PER_BLOCK = 2**20  # a profile's coefficients per block
 PAPER_FRAGMENT = 128
 PAPER_RESOLUTION = 0.0309e-3
 
@@ -119,11 +122,17 @@ def synthesize_profile(points, spacing, dimension, amplitude=None, rq=None, reso
     check_size((points,), "the profile")
     seed = _seed(seed)
     generator = np.random.Generator(np.random.PCG64(np.random.SeedSequence(seed)))
-    spectrum = _white_profile_spectrum(points, generator)
-    spectrum *= _profile_filter(
-        points, spacing, beta, model.prefactor(amplitude or 1.0, dimension, resolution), rolloff=rolloff
-    )
-    heights = _scaled(np.fft.irfft(spectrum, points), rq)
+    blocks, pieces = _blocks(points // 2 + 1, POINTS_PER_BLOCK), _blocks(points, POINTS_PER_BLOCK)
+    log.info(f"a profile of {points} points in {len(pieces)} blocks, one inverse FFT")
+    with progress(total=2 * len(blocks) + 1 + len(pieces), description="synth", unit="step") as bar:
+        spectrum = _white_profile_spectrum(points, generator, blocks, bar.update)
+        scale = model.prefactor(amplitude or 1.0, dimension, resolution)
+        for part in blocks:
+            spectrum[part] *= _profile_filter(points, spacing, beta, scale, rolloff=rolloff, part=part)
+            bar.update()
+        heights = np.fft.irfft(spectrum, points)  # one call: Ctrl-C waits for it (seconds at 2^26 points)
+        bar.update()
+        heights = _scaled(heights, rq, pieces, bar.update)
     parameters = _parameters(
         points=points,
         spacing=spacing,
@@ -220,12 +229,19 @@ def synthesize_map(
     resolution = _amplitude_choice(amplitude, rq, resolution, min(spacing))
     check_size((ny, nx), "the map")
     seed = _seed(seed)
-    spectrum = _white_map_spectrum(nx, ny, seed)
-    pairs = spectrum.view(np.float32).reshape(ny, nx // 2 + 1, 2)
-    pairs *= _map_filter(nx, ny, dx, dy, dimension, amplitude or 1.0, resolution, anisotropy, rolloff)[..., np.newaxis]
-    from scipy import fft
-
-    heights = _scaled(fft.irfft2(spectrum, (ny, nx), workers=-1, overwrite_x=True).astype(np.float64), rq)
+    blocks = _blocks(ny, ROWS_PER_BLOCK)
+    log.info(f"a {nx} × {ny} map in {len(blocks)} blocks of {ROWS_PER_BLOCK} rows, one inverse FFT")
+    columns = _blocks(nx // 2 + 1, max(1, -(-ROWS_PER_BLOCK * (nx // 2 + 1) // ny)))
+    with progress(total=4 * len(blocks) + len(columns), description="synth", unit="step") as bar:
+        spectrum = _white_map_spectrum(nx, ny, seed, bar.update)
+        pairs = spectrum.view(np.float32).reshape(ny, nx // 2 + 1, 2)
+        for rows in blocks:
+            gain = _map_filter(nx, ny, dx, dy, dimension, amplitude or 1.0, resolution, anisotropy, rolloff, rows)
+            pairs[rows] *= gain[..., np.newaxis]
+            bar.update()
+        heights = _inverse_transform(spectrum, nx, columns, blocks, bar.update)
+        spectrum = pairs = None
+        heights = _scaled(heights, rq, blocks, bar.update)
     if anisotropy is None:
         shape = {"dimension": dimension, "amplitude": amplitude}
     else:
@@ -353,21 +369,30 @@ def _seed(seed):
     return secrets.randbits(63) if seed is None else int(seed)
 
 
-def _white_profile_spectrum(n, generator):
-    """The rfft of n unit white-noise samples, drawn directly: E|Z_k|² = n."""
-    spectrum = generator.standard_normal(2 * (n // 2 + 1)).view(np.complex128) * math.sqrt(n / 2)
+def _white_profile_spectrum(n, generator, blocks=None, step=None):
+    """The rfft of n unit white-noise samples, drawn directly: E|Z_k|² = n. Drawn in
+    ``blocks`` of coefficients (the same numbers as in one draw), calling ``step()``
+    after each."""
+    spectrum = np.empty(n // 2 + 1, dtype=np.complex128)
+    flat = spectrum.view(np.float64)
+    for part in blocks or [slice(None)]:
+        generator.standard_normal(out=flat[2 * (part.start or 0) : None if part.stop is None else 2 * part.stop])
+        spectrum[part] *= math.sqrt(n / 2)
+        if step is not None:
+            step()
     spectrum[0] = 0.0
     if n % 2 == 0:
         spectrum[-1] = spectrum[-1].real * math.sqrt(2)
     return spectrum
 
 
-def _white_map_spectrum(nx, ny, seed):
+def _white_map_spectrum(nx, ny, seed, step=None):
     """The rfft2 of an ny × nx unit white-noise field, drawn directly: E|Z|² = nx·ny
     everywhere; the kx = 0 and kx = nx/2 columns are the FFTs of real noise, so they
     are Hermitian. Rows are drawn in fixed blocks with their own seeded generators.
     Single precision: its rounding (6e-8) is far below any spectrum's dynamic range,
-    and it halves the memory and time of the map's synthesis."""
+    and it halves the memory and time of the map's synthesis. Calls ``step()`` after
+    each block; Ctrl-C cancels the blocks not started."""
     columns = nx // 2 + 1
     spectrum = np.empty((ny, columns), dtype=np.complex64)
     flat = spectrum.view(np.float32)
@@ -379,8 +404,15 @@ def _white_map_spectrum(nx, ny, seed):
         generator.standard_normal(out=flat[blocks[index]], dtype=np.float32)
         flat[blocks[index]] *= np.float32(math.sqrt(nx * ny / 2))
 
-    with ThreadPoolExecutor(max_workers=os.cpu_count() or 1) as pool:
-        list(pool.map(fill, range(len(blocks))))
+    pool = ThreadPoolExecutor(max_workers=os.cpu_count() or 1)
+    try:
+        for future in [pool.submit(fill, index) for index in range(len(blocks))]:
+            while not _done(future):
+                pass
+            if step is not None:
+                step()
+    finally:
+        pool.shutdown(wait=False, cancel_futures=True)
     special = np.random.Generator(np.random.PCG64(sequences[-1]))
     for column in (0, nx // 2) if nx % 2 == 0 else (0,):
         spectrum[:, column] = np.fft.fft(special.standard_normal(ny) * math.sqrt(nx))
@@ -388,10 +420,33 @@ def _white_map_spectrum(nx, ny, seed):
     return spectrum
 
 
-def _profile_filter(n, spacing, beta, scale, shift=0, rolloff=None):
+def _inverse_transform(spectrum, nx, columns, rows, step):
+    """scipy's ``irfft2(spectrum, (ny, nx))`` in float64, in blocks (Ctrl-C waits for
+    one block, not the whole transform): the inverse transforms along y over blocks of
+    ``columns`` (in place), then along x over blocks of ``rows``, scaled by 1/(nx ny)
+    last, as pocketfft's irfft2 does: the same float32 results bit for bit (checked
+    against irfft2 on even and odd sizes and block splits: tests/test_progress.py)."""
+    from scipy import fft
+
+    ny = spectrum.shape[0]
+    for part in columns:
+        spectrum[:, part] = fft.ifft(spectrum[:, part], axis=0, norm="forward", workers=-1)
+        step()
+    scale = np.float32(np.longdouble(1) / np.longdouble(nx * ny))  # pocketfft's T(1 / (long double) n)
+    heights = np.empty((ny, nx))
+    for part in rows:
+        piece = fft.irfft(spectrum[part], nx, axis=1, norm="forward", workers=-1)
+        piece *= scale
+        heights[part] = piece
+        step()
+    return heights
+
+
+def _profile_filter(n, spacing, beta, scale, shift=0, rolloff=None, part=slice(None)):
     """sqrt(G(f_k) / (2Δx)) with G = scale · f^-β (flat below 1/rolloff); zero at
-    k = 0 unless shifted."""
-    index = np.arange(n // 2 + 1, dtype=np.float64) + shift
+    k = 0 unless shifted. ``part``: a slice of the coefficients (element for element
+    the same values)."""
+    index = np.arange(n // 2 + 1, dtype=np.float64)[part] + shift
     frequencies = index / (n * spacing)
     if rolloff is not None:
         frequencies = np.where(index > 0, np.maximum(frequencies, 1 / rolloff), 0.0)
@@ -401,15 +456,18 @@ def _profile_filter(n, spacing, beta, scale, shift=0, rolloff=None):
     return gain
 
 
-def _map_filter(nx, ny, dx, dy, dimension, amplitude, resolution, anisotropy, rolloff=None):
+def _map_filter(nx, ny, dx, dy, dimension, amplitude, resolution, anisotropy, rolloff=None, rows=slice(None)):
     """sqrt(P2(f) / (Δx Δy)) on the rfft2 grid, in float32, zero at f = 0 (and flat
-    below 1/rolloff)."""
+    below 1/rolloff). ``rows``: a slice of the grid's rows (element for element the
+    same values)."""
     fx = (np.arange(nx // 2 + 1) / (nx * dx)).astype(np.float32)
-    fy = np.fft.fftfreq(ny, dy).astype(np.float32)
+    fy = np.fft.fftfreq(ny, dy).astype(np.float32)[rows]
+    origin = (rows.start or 0) == 0  # the block holds f = 0
     squared = fy[:, np.newaxis] ** 2 + fx[np.newaxis, :] ** 2
     if rolloff is not None:
         np.maximum(squared, np.float32(rolloff**-2), out=squared)
-    squared[0, 0] = 1.0
+    if origin:
+        squared[0, 0] = 1.0
     if anisotropy is None:
         alpha = model.map_exponent(dimension)
         scale = model.map_prefactor(amplitude, dimension, resolution) / (dx * dy)
@@ -421,7 +479,8 @@ def _map_filter(nx, ny, dx, dy, dimension, amplitude, resolution, anisotropy, ro
         log_amplitude = weight * np.float32(math.log(c1)) + (1 - weight) * np.float32(math.log(c2))
         log_scale = _log_map_prefactor(log_amplitude, dimensions, resolution) - np.float32(math.log(dx * dy))
         gain = np.exp(np.float32(0.5) * log_scale - (np.float32(4.0) - dimensions) * np.float32(0.5) * np.log(squared))
-    gain[0, 0] = 0.0
+    if origin:
+        gain[0, 0] = 0.0
     return gain
 
 
@@ -434,11 +493,42 @@ def _log_map_prefactor(log_amplitude, dimensions, resolution):
     return (log_amplitude + (2.0 * dimensions - 5.0) * math.log(resolution) + log_factor).astype(np.float32)
 
 
-def _scaled(heights, rq):
-    if rq is None:
-        return heights
-    centred = heights - heights.mean()
-    return centred * (rq / math.sqrt(np.mean(centred * centred)))
+def _scaled(heights, rq, blocks=None, step=None):
+    """``heights`` with their mean removed and scaled to RMS ``rq`` (None: as they are),
+    in place, in ``blocks`` of the first axis, calling ``step()`` after each; the two
+    means are one reduction each, bit for bit those of whole arrays."""
+    blocks = blocks or [slice(None)]
+    if rq is not None:
+        mean = heights.mean()
+        squares = np.empty_like(heights)
+        for part in blocks:
+            heights[part] -= mean
+            np.multiply(heights[part], heights[part], out=squares[part])
+        factor = rq / math.sqrt(np.mean(squares))
+        squares = None
+    for part in blocks:
+        if rq is not None:
+            heights[part] *= factor
+        if step is not None:
+            step()
+    return heights
+
+
+def _blocks(count, size):
+    """Slices of ``size`` along an axis of ``count`` (at least one)."""
+    return [slice(start, min(start + size, count)) for start in range(0, max(count, 1), size)]
+
+
+def _done(future):
+    """True once ``future`` is done (raising its error), False after waiting 0.1 s for
+    it: a wait with a timeout, so that Ctrl-C gets through."""
+    from concurrent.futures import TimeoutError as Pending
+
+    try:
+        future.result(timeout=0.1)
+    except Pending:
+        return False
+    return True
 
 
 def _parameters(**values):

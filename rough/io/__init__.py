@@ -181,6 +181,7 @@ def read(source, *, spacing=None, unit=None, verify=True, channel=None, layer=No
         with _named(name):
             surface = read_bytes(data, options, name=name)
     surface.metadata.setdefault("source", name)
+    log.info("read %s: %s, %s points", name, describe(surface.source_format), " × ".join(map(str, surface.points)))
     return surface
 
 
@@ -272,8 +273,16 @@ def _checked(surface, format_name, options, windowed=False):
         raise FormatError(f"holds {surface.heights.size} point; a surface needs at least two points")
     if np.isnan(surface.heights).all():
         raise FormatError(f"holds no valid points (all {surface.heights.size} heights are invalid)")
-    if options.spacing is not None and surface.spacing != options.spacing:
-        surface = dataclasses.replace(surface, spacing=options.spacing[: surface.heights.ndim])
+    given = None if options.spacing is None else options.spacing[: surface.heights.ndim]
+    if given is not None and tuple(surface.spacing) != tuple(given):
+        from ..units import format_length
+
+        log.warning(
+            "the spacing given, %s, overrides the file's own, %s",
+            " × ".join(map(format_length, given)),
+            " × ".join(map(format_length, surface.spacing)),
+        )
+        surface = dataclasses.replace(surface, spacing=given)
     if options.window is not None and not windowed:
         x, y = options.window
         if y is not None and surface.is_profile:
@@ -377,7 +386,13 @@ def format_for_path(path):
     table = registry.extensions()
     if extension not in table:
         known = ", ".join(sorted(table))
-        raise InputError(f"{path}: cannot tell the format from the extension (use {known}, or -f FORMAT)")
+        read_only = next((f.title for f in registry.formats().values() if extension in f.extensions), None)
+        problem = (
+            f"rough reads {read_only} ({extension}) but does not write it"
+            if read_only
+            else "cannot tell the format from the extension"
+        )
+        raise InputError(f"{path}: {problem} (use {known}, or -f FORMAT)")
     return table[extension]
 
 

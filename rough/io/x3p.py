@@ -646,8 +646,13 @@ def _store(archive, name, content, align=None):
 
 
 def _zip_time():
+    """The ZIP entries' time: ZIP cannot hold one before 1980, so earlier ones (as
+    SOURCE_DATE_EPOCH=0 asks for) are stored as 1980-01-01 00:00:00."""
     stamp = timestamp()
-    return tuple(int(part) for part in (stamp[0:4], stamp[5:7], stamp[8:10], stamp[11:13], stamp[14:16], stamp[17:19]))
+    moment = tuple(
+        int(part) for part in (stamp[0:4], stamp[5:7], stamp[8:10], stamp[11:13], stamp[14:16], stamp[17:19])
+    )
+    return max(moment, (1980, 1, 1, 0, 0, 0))
 
 
 def _main_xml(surface, data_md5, mask_md5):

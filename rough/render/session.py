@@ -57,9 +57,11 @@ def run_hid(spec, tracks, model, friction, settings, stick_span=None, invert=())
 
 
 def summary_rows(runs, model_name, model, friction_spec):
-    """Report rows (key, value, unit, text) and the JSON document of ``runs``."""
+    """Report rows ``(key, value, unit, text, label)`` and the JSON document of ``runs``:
+    ``{"runs": [one dict per run]}``, the rows keyed ``runs.I.KEY`` and labelled
+    ``KEY`` (``SPEED.KEY`` for several runs)."""
     rows, documents = [], []
-    for label, result in runs:
+    for index, (label, result) in enumerate(runs):
         timing, statistics = result.timing(), forces(result)
         prefix = f"{label}." if len(runs) > 1 else ""
         document = {
@@ -73,11 +75,11 @@ def summary_rows(runs, model_name, model, friction_spec):
             **statistics,
         }
         documents.append(document)
-        rows += _rows(prefix, document, model)
-    return rows, {"runs": documents} if len(documents) > 1 else documents[0]
+        rows += [(f"runs.{index}.{key}", *rest, prefix + key) for key, *rest in _rows(document, model)]
+    return rows, {"runs": documents}
 
 
-def _rows(prefix, d, model):
+def _rows(d, model):
     rows = [
         (
             "device",
@@ -104,13 +106,9 @@ def _rows(prefix, d, model):
     if "rate" in d:
         rows += [
             ("rate", d["rate"], "Hz", f"{d['rate']:.1f} Hz achieved ({d['scheduling']})"),
-            (
-                "jitter",
-                [d["jitter_p50"], d["jitter_p99"], d["jitter_max"]],
-                "s",
-                f"period jitter p50 {d['jitter_p50'] * 1e6:.1f} µs, p99 {d['jitter_p99'] * 1e6:.1f} µs, "
-                f"max {d['jitter_max'] * 1e6:.1f} µs",
-            ),
+            ("jitter_p50", d["jitter_p50"], "s", f"{d['jitter_p50'] * 1e6:.1f} µs period jitter, median"),
+            ("jitter_p99", d["jitter_p99"], "s", f"{d['jitter_p99'] * 1e6:.1f} µs period jitter, 99th percentile"),
+            ("jitter_max", d["jitter_max"], "s", f"{d['jitter_max'] * 1e6:.1f} µs period jitter, largest"),
             (
                 "missed_deadlines",
                 d["missed_deadlines"],
@@ -119,12 +117,9 @@ def _rows(prefix, d, model):
             ),
         ]
     rows += [
-        (
-            "F_y",
-            [d["F_y_mean"], d["F_y_std"], d["F_y_max"]],
-            "N",
-            f"mean {d['F_y_mean']:.4f} N, std {d['F_y_std']:.4f} N, max {d['F_y_max']:.4f} N",
-        ),
+        ("F_y_mean", d["F_y_mean"], "N", f"{d['F_y_mean']:.4f} N normal force, mean"),
+        ("F_y_std", d["F_y_std"], "N", f"{d['F_y_std']:.4f} N normal force, standard deviation"),
+        ("F_y_max", d["F_y_max"], "N", f"{d['F_y_max']:.4f} N normal force, largest"),
         ("F_x_rms", d["F_x_rms"], "N", f"{d['F_x_rms']:.4f} N RMS"),
         ("out_of_contact", d["out_of_contact"], "1", f"{100 * d['out_of_contact']:.2f} % of ticks"),
         ("at_force_limit", d["at_force_limit"], "1", f"{100 * d['at_force_limit']:.2f} % of ticks"),
@@ -135,7 +130,7 @@ def _rows(prefix, d, model):
             d["ended_by"] + (f"; trigger switched surfaces {d['surface_switches']}×" if d["surface_switches"] else ""),
         ),
     ]
-    return [(prefix + key, value, unit, text) for key, value, unit, text in rows]
+    return rows
 
 
 def _describe(model):

@@ -1,0 +1,128 @@
+"""Several inputs in one call: each is read and worked on in turn, a bad one is
+reported in one line and skipped, and the exit status at the end is the worst seen.
+
+Side files (``--plot``, ``--psd``, ``--list``, ``show -o``) then need ``{stem}`` (the
+input's name without directory and extension) or ``{name}`` in their names, and a
+surface output ``-o`` names a directory (``out/``).
+"""
+
+import os
+
+import click
+
+#: The options that name a file written beside the report (or instead of one), and their flags.
+SIDE_FILES = {"plot": "--plot", "psd_file": "--psd", "feature_list": "--list", "figure_file": "-o"}
+
+
+def run_each(work, names, options):
+    """Call ``work(name, **options)`` for each input in ``names`` and print the
+    :class:`~rough.cli.report.Report` it returns (if any) in the format of
+    ``options``' ``as_json``/``as_tsv``. Returns the exit status."""
+    from .report import Printer
+
+    many = len(names) > 1
+    check_inputs(names)
+    printer = Printer(options.pop("as_json", False), options.pop("as_tsv", False), many)
+    side = {key: options[key] for key in SIDE_FILES if options.get(key)}
+    if many:
+        _check_side_files(side)
+        if "output" in options:
+            options["output"].check_directory(names)
+    status = 0
+    for name in _progress(names, many):
+        named = {**options, **{key: stem_name(path, name) for key, path in side.items()}}
+        if "output" in options:
+            named["output"] = options["output"].for_input(name)
+        report, warnings, failed = _one(work, name, named, many)
+        status = max(status, failed)
+        if report is not None:
+            printer.print(report, name, warnings)
+    return status
+
+
+def read_named(name, options):
+    """The surface in input ``name`` (see :func:`rough.io.read`)."""
+    from ..io import read
+
+    return read(name, **options)
+
+
+def _one(work, name, options, many):
+    """(report, warnings, status) of one input; with several, a failure is reported
+    and its status returned instead of raised."""
+    from ..errors import InputError
+    from . import main
+    from .report import collected_warnings
+
+    main.current_input[:] = [printable_name(name)] if many else []
+    try:
+        with collected_warnings() as warnings:
+            report = work(name, **options)
+        return report, warnings, 0
+    except InputError as error:
+        named = _named_error(error, name)
+        if not many:
+            raise named from error
+        failed = named
+    except click.ClickException:
+        raise
+    except Exception as error:  # noqa: BLE001 -- with several inputs one failure must not stop the rest
+        if not many:
+            raise
+        failed = error
+    finally:
+        main.current_input[:] = []
+    message, status = main.failure(failed)
+    main.say(message)
+    return None, [], status
+
+
+def _named_error(error, name):
+    """The error with the input's name in front, unless it names a file already."""
+    shown = printable_name(name)
+    if error.filename is not None or str(error).startswith(f"{shown}: "):
+        return error
+    named = type(error).__new__(type(error))
+    named.__dict__.update(error.__dict__)
+    named.args = (f"{shown}: {error}",)
+    return named
+
+
+def printable_name(name):
+    return "<stdin>" if name == "-" else name
+
+
+def stem_name(template, name):
+    """A side file's name for input ``name``: ``{stem}`` and ``{name}`` filled in."""
+    base = "stdin" if name == "-" else os.path.basename(name)
+    return template.replace(
+        "{stem}", base.split(".")[0] if base.startswith(".") else os.path.splitext(base)[0]
+    ).replace("{name}", base)
+
+
+def check_inputs(names):
+    if names.count("-") > 1:
+        raise click.UsageError("standard input (-) can be read only once")
+    import sys
+
+    if "-" in names and sys.stdin is None:
+        from ..errors import InputError
+
+        raise InputError("<stdin>: standard input is closed")
+
+
+def _check_side_files(side):
+    for key, path in side.items():
+        option = SIDE_FILES[key]
+        if path == "-":
+            raise click.UsageError(f"with several inputs, {option} cannot go to standard output")
+        if "{stem}" not in path and "{name}" not in path:
+            raise click.UsageError(f"with several inputs, put {{stem}} in {option}'s file name, e.g. {{stem}}.png")
+
+
+def _progress(names, many):
+    if not many:
+        return names
+    from ..progress import progress
+
+    return progress(names, total=len(names), description="files", unit="file")
