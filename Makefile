@@ -94,6 +94,8 @@ bench: $(BIN)/.installed
 	$(BIN)/python bench/bench_fractal.py
 	$(BIN)/python bench/bench_render.py
 	$(BIN)/python bench/bench_tip.py
+	$(BIN)/python bench/bench_scaling.py
+	$(BIN)/python bench/bench_batch.py
 
 fuzz: $(BIN)/.installed
 	$(BIN)/python -m pip install --quiet atheris

@@ -1,8 +1,8 @@
 """Speed of the probe-size operations: a 10^6-point profile and a 2048 × 2048 map with a
 0.5 mm tip at 0.01 mm spacing (a disk of 101 samples; a ball of 7845), as ratios to one
-FFT of the same data. Both are exact brute force in compiled code (scipy.ndimage for
-profiles, scikit-image's OpenMP rolling-ball kernel for maps), so the cost grows with
-the tip's footprint in samples.
+FFT of the same data. Both are exact brute force in compiled code (scikit-image's
+rolling-ball kernel, in tiles over the cores), so the cost grows with the tip's
+footprint in samples.
 
     python bench/bench_tip.py            # about two minutes
     python bench/bench_tip.py --quick    # a 1024 × 1024 map

@@ -60,10 +60,9 @@ def _one(work, name, options, many):
             report = work(name, **options)
         return report, warnings, 0
     except InputError as error:
-        named = _named_error(error, name)
+        failed = _named_error(error, name)
         if not many:
-            raise named from error
-        failed = named
+            raise
     except click.ClickException:
         raise
     except Exception as error:  # noqa: BLE001 -- with several inputs one failure must not stop the rest
@@ -78,14 +77,11 @@ def _one(work, name, options, many):
 
 
 def _named_error(error, name):
-    """The error with the input's name in front, unless it names a file already."""
+    """The error, its message led by the input's name unless it names a file already."""
     shown = printable_name(name)
-    if error.filename is not None or str(error).startswith(f"{shown}: "):
-        return error
-    named = type(error).__new__(type(error))
-    named.__dict__.update(error.__dict__)
-    named.args = (f"{shown}: {error}",)
-    return named
+    if error.filename is None and not str(error).startswith(f"{shown}: "):
+        error.args = (f"{shown}: {error}", *error.args[1:])
+    return error
 
 
 def printable_name(name):
