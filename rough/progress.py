@@ -5,10 +5,9 @@ is enabled (the command line's ``-q`` disables it) and standard error is a termi
 and it disappears when the work is done: pipes, files and logs never receive one.
 """
 
+import functools
 import logging
 import sys
-
-from tqdm import tqdm
 
 DELAY = 2.0  # seconds of work before a bar is drawn
 _state = {"enabled": True}
@@ -69,7 +68,7 @@ def progress(iterable=None, *, total=None, description="", unit="step"):
     stream = sys.stderr
     if total is None and iterable is not None and hasattr(iterable, "__len__"):
         total = len(iterable)
-    return _Bar(
+    return _bar_class()(
         iterable,
         total=total,
         desc=description or None,
@@ -83,27 +82,35 @@ def progress(iterable=None, *, total=None, description="", unit="step"):
     )
 
 
-class _Bar(tqdm):
-    """A tqdm bar that, while drawn, sends rough's log lines through ``tqdm.write``,
-    so that a warning in the middle of the work does not land on the bar's line."""
+@functools.cache
+def _bar_class():
+    """The bar class, made on first use so that starting a command does not import
+    tqdm (about 75 ms) when no long work comes."""
+    from tqdm import tqdm
 
-    def __init__(self, *args, **kwargs):
-        self._redirect = None
-        super().__init__(*args, **kwargs)
-        logger = logging.getLogger("rough")
-        if not self.disable and any(isinstance(h, logging.StreamHandler) for h in logger.handlers):
-            from tqdm.contrib.logging import logging_redirect_tqdm
+    class Bar(tqdm):
+        """A tqdm bar that, while drawn, sends rough's log lines through ``tqdm.write``,
+        so that a warning in the middle of the work does not land on the bar's line."""
 
-            self._redirect = logging_redirect_tqdm([logger], tqdm_class=tqdm)
-            self._redirect.__enter__()
+        def __init__(self, *args, **kwargs):
+            self._redirect = None
+            super().__init__(*args, **kwargs)
+            logger = logging.getLogger("rough")
+            if not self.disable and any(isinstance(h, logging.StreamHandler) for h in logger.handlers):
+                from tqdm.contrib.logging import logging_redirect_tqdm
 
-    def close(self):
-        try:
-            super().close()
-        finally:
-            redirect, self._redirect = getattr(self, "_redirect", None), None
-            if redirect is not None:
-                redirect.__exit__(None, None, None)
+                self._redirect = logging_redirect_tqdm([logger], tqdm_class=tqdm)
+                self._redirect.__enter__()
+
+        def close(self):
+            try:
+                super().close()
+            finally:
+                redirect, self._redirect = getattr(self, "_redirect", None), None
+                if redirect is not None:
+                    redirect.__exit__(None, None, None)
+
+    return Bar
 
 
 def _is_terminal(stream):

@@ -4,7 +4,7 @@ slides' feature detection and Rq against evaluation length."""
 import click
 
 from .options import LENGTH, crop_option, plot_option, report_format, surface_input
-from .report import Report, on_stdout
+from .report import Report, on_stdout, shown
 
 
 @click.command(short_help="ISO parameters (Ra…JRC, Sa…Std), amplitude density, feature detection.")
@@ -150,8 +150,7 @@ def features(
     if plot:
         from .. import plots
 
-        name = "standard input" if input == "-" else input
-        plots.save(plots.features_figure(evaluated, found, (centres, density), title=name), plot)
+        plots.save(plots.features_figure(evaluated, found, (centres, density), title=shown(input)), plot)
     return Report(rows, document) if report else None
 
 

@@ -3,7 +3,7 @@
 import click
 
 from .options import BAND, LENGTH, crop_option, model_options, plot_option, report_format, surface_input
-from .report import Report, on_stdout
+from .report import Report, on_stdout, shown
 
 
 @click.command("fit-fractal", short_help="Fractal dimension D and amplitude coefficient C, with uncertainty.")
@@ -138,9 +138,8 @@ def fit_fractal(
 
 def _title(input, surface):
     """A figure's title: the input's name, and the surface's own title if it has one."""
-    name = "standard input" if input == "-" else input
     title = surface.metadata.get("title")
-    return f"{name}: {title}" if title else name
+    return f"{shown(input)}: {title}" if title else shown(input)
 
 
 def _rows(result, surface, document):

@@ -4,7 +4,7 @@ import click
 
 from .haptics import DAMPING, FORCE, MASS, SPEED, STIFFNESS, TIME, haptic_options
 from .options import CROP, POSITION, TIP, input_options, plot_option, report_format
-from .report import Report, on_stdout
+from .report import Report, on_stdout, shown
 
 
 @click.command(short_help="The haptic contact loop on a USB force-feedback joystick or a simulated hand.")
@@ -120,7 +120,7 @@ def render(
         )
     else:
         runs = [run_hid(haptics.device, tracks, contact, friction, settings, haptics.stick_span, haptics.invert)]
-    _outputs(runs, trace, plot, "standard input" if inputs[0] == "-" else inputs[0])
+    _outputs(runs, trace, plot, shown(inputs[0]))
     return Report(*summary_rows(runs, haptics.model, contact, haptics.friction)) if report else None
 
 

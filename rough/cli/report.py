@@ -40,6 +40,11 @@ def printable(text):
     return "".join(c if c.isprintable() else repr(c)[1:-1] for c in str(text))
 
 
+def shown(file):
+    """An input's name for people (figure titles, the text table): ``-`` is standard input."""
+    return "standard input" if file == "-" else file
+
+
 def echo(line):
     """Print one line on standard output; a RoughError when it is closed."""
     from ..io.atomic import standard_output
@@ -104,7 +109,7 @@ class Printer:
 
     def _table(self, rows, file):
         if file is not None:
-            rows = [("file", file, "", "standard input" if file == "-" else file), *rows]
+            rows = [("file", file, "", shown(file)), *rows]
         labels = [row[4] if len(row) > 4 else row[0] for row in rows]
         width = max(map(len, labels))
         if self.many and self.printed:

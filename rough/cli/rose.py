@@ -3,7 +3,7 @@
 import click
 
 from .options import BAND, LENGTH, crop_option, model_options, plot_option, report_format, surface_input
-from .report import Report, on_stdout
+from .report import Report, on_stdout, shown
 
 
 @click.command(short_help="D(θ) and C(θ) by direction for maps (the amplitude coefficient rose); Str, Std.")
@@ -75,7 +75,7 @@ def rose(surface, input, step, width, band, resolution, order, sampling, fill, n
     if plot:
         from .. import plots
 
-        plots.save(plots.rose_figure(result, "standard input" if input == "-" else input), plot)
+        plots.save(plots.rose_figure(result, shown(input)), plot)
     return None if on_stdout(plot=plot) else Report(_rows(result), result.as_dict())
 
 

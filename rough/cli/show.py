@@ -98,6 +98,7 @@ def show(surface, input, figure_file, figure_format, title, hillshade, order, co
         rough show a.x3p b.x3p -o {stem}.png
     """
     from .. import plots
+    from .report import shown
 
     format = _format(figure_file, figure_format)
     note = None
@@ -108,6 +109,7 @@ def show(surface, input, figure_file, figure_format, title, hillshade, order, co
         note = {0: "mean removed", 1: "least-squares plane removed"}.get(
             order, f"least-squares polynomial of degree {order} removed"
         )
-    name = "standard input" if input == "-" else input
-    figure = plots.surface_figure(surface, title=title or name, hillshade=hillshade, note=note, colormap=colormap)
+    figure = plots.surface_figure(
+        surface, title=title or shown(input), hillshade=hillshade, note=note, colormap=colormap
+    )
     plots.save(figure, figure_file, format=format, dpi=dpi)
