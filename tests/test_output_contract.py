@@ -198,3 +198,11 @@ def test_warnings_name_the_file_when_there_are_several(tmp_path):
         f"rough info: {MAP}: warning: the spacing given, 1 µm × 1 µm, overrides the file's own, 50 µm × 50 µm" in lines
     )
     assert any(line.startswith(f"rough info: {PROFILE}: warning: the spacing given") for line in lines)
+
+
+def test_side_file_names_take_the_inputs_stem():
+    from rough.cli.batch import stem_name
+
+    assert stem_name("plots/{stem}.png", "scans/a.b.x3p") == "plots/a.b.png"
+    assert stem_name("{stem}.png", "scans/.hidden.x3p") == ".hidden.png"
+    assert stem_name("{name}.json", "-") == "stdin.json"

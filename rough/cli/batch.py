@@ -91,9 +91,7 @@ def printable_name(name):
 def stem_name(template, name):
     """A side file's name for input ``name``: ``{stem}`` and ``{name}`` filled in."""
     base = "stdin" if name == "-" else os.path.basename(name)
-    return template.replace(
-        "{stem}", base.split(".")[0] if base.startswith(".") else os.path.splitext(base)[0]
-    ).replace("{name}", base)
+    return template.replace("{stem}", os.path.splitext(base)[0]).replace("{name}", base)
 
 
 def check_inputs(names):
