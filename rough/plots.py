@@ -498,10 +498,12 @@ def surface_figure(surface, title=None, hillshade=False, note=None, colormap="vi
 
 
 @_styled
-def features_figure(surface, features=(), density=None, title=None):
+def features_figure(surface, features=(), density=None, material_ratio=None, title=None):
     """A profile with its detected features shaded, or a map as :func:`surface_figure`
-    draws it; and, given ``density``, the amplitude probability density of the
-    heights with the Gaussian of the same Rq.
+    draws it; given ``density``, the amplitude probability density of the heights
+    with the Gaussian of the same Rq; given ``material_ratio``, beside it the
+    Abbott–Firestone curve with the ISO 13565-2 construction (the 40 % central
+    region, the equivalent straight line, and the triangles of Rpk and Rvk).
 
     Parameters
     ----------
@@ -511,6 +513,8 @@ def features_figure(surface, features=(), density=None, title=None):
         Detected features (``kind``, ``start``, ``end``), profiles only.
     density : tuple of numpy.ndarray, optional
         ``(centres, density)`` from :func:`rough.metrology.amplitude_density`.
+    material_ratio : rough.metrology.MaterialRatioCurve, optional
+        The curve to draw, with its :meth:`~rough.metrology.MaterialRatioCurve.core`.
     title : str, optional
         The figure's title, e.g. the file name; default the surface's ``title``
         metadata, else ``"profile"`` or ``"map"``.
@@ -522,10 +526,12 @@ def features_figure(surface, features=(), density=None, title=None):
     plt = _pyplot()
     title = title or surface.metadata.get("title") or surface.kind
     heights = surface.heights - np.nanmean(surface.heights)
-    density_height = 3.0 if density is not None else 0.0
+    below = density is not None or material_ratio is not None
+    density_height = 3.0 if below else 0.0
     if surface.is_profile:
         figure = plt.figure(figsize=(8, 3.6 + density_height))
-        top = figure.add_subplot(2 if density is not None else 1, 1, 1)
+        grid = figure.add_gridspec(2 if below else 1, 2)
+        top = figure.add_subplot(grid[0, :])
         centred = surface.derive("centre", {}, heights=heights)
         scale = _draw_profile(top, centred, quantity="height about the mean")
         for feature in features:
@@ -537,16 +543,22 @@ def features_figure(surface, features=(), density=None, title=None):
                 lw=0,
             )
         top.set_title(f"{_facts(surface)}: {len(features)} features shaded", fontsize=9, color="0.25")
-        bottom = figure.add_subplot(2, 1, 2) if density is not None else None
+        panels = [figure.add_subplot(grid[1, 0]), figure.add_subplot(grid[1, 1])] if below else []
     else:
         layout = _MapLayout(surface.size[0] / surface.size[1], width=7.0, height=5.0, below=density_height)
-        figure, top, bar = layout.figure(plt, least_width=7.5 if density is not None else 0.0)
+        figure, top, bar = layout.figure(plt, least_width=8.0 if below else 0.0)
         centred = surface.derive("centre", {}, heights=heights)
         _draw_map(figure, top, bar, layout.location, centred, quantity="height about the mean")
         top.set_title(_facts(surface), fontsize=9, color="0.25")
         width, height = figure.get_size_inches()
-        rectangle = (_MapLayout.LEFT, 0.55, width - _MapLayout.LEFT - 0.35, density_height - 0.85)
-        bottom = figure.add_axes(_MapLayout._fraction(rectangle, width, height)) if density is not None else None
+        half = (width - _MapLayout.LEFT - 0.35 - 0.8) / 2
+        rectangles = [(_MapLayout.LEFT + k * (half + 0.8), 0.55, half, density_height - 0.85) for k in (0, 1)]
+        panels = [figure.add_axes(_MapLayout._fraction(r, width, height)) for r in rectangles] if below else []
+    if material_ratio is not None:
+        _draw_abbott(panels[1], material_ratio, "R" if surface.is_profile else "S")
+    if panels and density is None:
+        panels[0].remove()
+    bottom = panels[0] if panels else None
     if density is not None:
         centres, values = density
         z_scale, z_unit = length_unit(float(centres[-1] - centres[0]) if len(centres) > 1 else 0.0)
@@ -569,6 +581,31 @@ def features_figure(surface, features=(), density=None, title=None):
     else:
         layout.title(figure, title)
     return figure
+
+
+def _draw_abbott(axes, curve, prefix):
+    """The material-ratio curve (height against %) with the ISO 13565-2 construction."""
+    core = curve.core()
+    scale, unit = length_unit(float(curve.heights[0] - curve.heights[-1]))
+    step = max(1, curve.heights.size // 4000)
+    ratios, heights = curve.ratios[::step], curve.heights[::step] * scale
+    axes.plot(ratios, heights, color="0.2", lw=1.2, label="material-ratio curve")
+    axes.axvspan(*core.window, color="tab:green", alpha=0.12, lw=0, label="40 % central region")
+    top, bottom = core.top * scale, core.bottom * scale
+    axes.plot([0, 100], [top, bottom], color="tab:green", lw=1.2, label="equivalent straight line")
+    for level in (top, bottom):
+        axes.axhline(level, color="tab:green", lw=0.6, ls="--")
+    peak, valley = core.reduced_peak * scale, core.reduced_valley * scale
+    axes.fill([0, 0, core.mr1], [top, top + peak, top], color="tab:red", alpha=0.35, lw=0, label=f"{prefix}pk")
+    axes.fill([100, 100, core.mr2], [bottom, bottom - valley, bottom], color="tab:blue", alpha=0.35, lw=0)
+    axes.annotate(f"{prefix}vk", (100, bottom - valley), ha="right", va="top", fontsize=8, color="tab:blue")
+    axes.annotate(
+        f"{prefix}k = {core.height * scale:.4g} {unit}", (50, (top + bottom) / 2), ha="left", va="bottom", fontsize=8
+    )
+    axes.set_xlim(0, 100)
+    axes.set_xlabel("material ratio (%)")
+    axes.set_ylabel(f"height about the mean ({unit})")
+    axes.legend(fontsize=7, loc="upper right")
 
 
 @_styled

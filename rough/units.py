@@ -111,19 +111,45 @@ def format_si(value, unit, digits=5):
 
 
 def format_quantity(value, unit, digits=5):
-    """A number with its unit for people: ``unit`` is ``m`` (SI prefix chosen),
-    ``1/m`` (printed per mm), ``1`` (a pure number), ``%`` or ``deg``."""
+    """A number with its unit for people: ``unit`` is ``m``, ``m2``, ``m3`` (SI prefix
+    chosen), ``1/m`` (printed per mm), ``1/m2`` (per mm²), ``m3/m2`` (a volume per
+    area, µm³/µm²), ``m·%`` (a height times a material ratio), ``1`` (a pure number),
+    ``%`` or ``deg``.
+
+    >>> format_quantity(2.5e-9, "m2"), format_quantity(3.6e6, "1/m2"), format_quantity(1.48e-8, "m3/m2")
+    ('0.0025 mm²', '3.6 /mm²', '0.0148 µm³/µm²')
+    """
     if value is None or (isinstance(value, float) and math.isnan(value)):
         return "undefined"
     if unit == "m":
         return format_length(value, digits)
+    if unit in _POWERS:
+        return _format_power(value, _POWERS[unit], digits)
+    if unit == "m3/m2":
+        return f"{value * 1e6:.{digits}g} µm³/µm²"  # = ml/m², the unit tribologists quote
+    if unit == "m·%":
+        return f"{format_length(value, digits)}·%"
     if unit == "1/m":
         return f"{value * 1e-3:.{digits}g} /mm"
+    if unit == "1/m2":
+        return f"{value * 1e-6:.{digits}g} /mm²"
     if unit == "%":
         return f"{value:.{digits}g} %"
     if unit == "deg":
         return f"{value:.{digits}g}°"
     return f"{value:.{digits}g}"
+
+
+_POWERS = {"m2": 2, "m3": 3}
+
+
+def _format_power(value, power, digits):
+    """An area or volume in the largest prefix that leaves at least a thousandth:
+    2.5e-9 m² → 0.0025 mm², 7.8e-7 m² → 0.78 mm², 2.5e-13 m² → 0.25 µm²."""
+    if value == 0 or not math.isfinite(value):
+        return f"{value:.{digits}g} m{'²³'[power - 2]}"
+    scale, prefix = next(((s, p) for s, p in _PREFIXES if abs(value) >= 1e-3 * s**power), _PREFIXES[-1])
+    return f"{value / scale**power:.{digits}g} {prefix}m{'²³'[power - 2]}"
 
 
 _FREQUENCY = re.compile(

@@ -1,5 +1,5 @@
-"""Fixtures shared by the tests: the third-party data folder, and running ``rough``
-as a separate process exactly as a shell user would."""
+"""Fixtures shared by the tests: the third-party data folder, running ``rough`` as a
+separate process exactly as a shell user would, and surfalize's seeded test data."""
 
 import os
 import pathlib
@@ -29,6 +29,18 @@ def shared_data():
     if folder is None:
         pytest.skip("../shared/data (third-party reference files) is not beside this checkout")
     return folder / "data"
+
+
+def surfalize_heights():
+    """surfalize's seeded test surface (its tests/conftest.py): 700 × 1000 points,
+    meant at a step of 0.1 (µm, as surfalize's steps are)."""
+    import numpy as np
+
+    np.random.seed(0)
+    x, y = np.meshgrid(np.arange(1000), np.arange(700))
+    z = np.sin(x / 200 * 2 * np.pi)
+    z += 0.5 * (np.sin((x - 200 / 2) / 200 * 2 * np.pi) + 1) * 0.3 * np.sin((np.sin(y / 10) + x) / 10 * 2 * np.pi)
+    return z + np.random.normal(size=z.shape) / 5
 
 
 def rough(*args, input=None, check=False, env=None, timeout=120):

@@ -30,7 +30,7 @@ def test_extreme_ratio_sampling_leaves_ordinary_maps_unchanged():
 
 def test_every_undefined_parameter_is_named(caplog):
     """A NaN result without a listed reason still gets a warning."""
-    from rough.metrology import _announce_undefined as announce
+    from rough.metrology import announce_undefined as announce
 
     with caplog.at_level(logging.WARNING, logger="rough"):
         announce({"Ra": 1e-6, "peak_density": float("nan")})

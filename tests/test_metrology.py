@@ -23,6 +23,8 @@ from rough.metrology import (
 )
 from rough.metrology.filters import ALPHA
 
+from conftest import surfalize_heights
+
 # -- analytic results -------------------------------------------------------------------
 
 
@@ -159,12 +161,7 @@ def test_surfalize_profile_fixture():
 
 
 def test_surfalize_surface_fixture():
-    np.random.seed(0)
-    x, y = np.meshgrid(np.arange(1000), np.arange(700))
-    z = np.sin(x / 200 * 2 * np.pi)
-    z += 0.5 * (np.sin((x - 200 / 2) / 200 * 2 * np.pi) + 1) * 0.3 * np.sin((np.sin(y / 10) + x) / 10 * 2 * np.pi)
-    z += np.random.normal(size=z.shape) / 5
-    values = areal_parameters(Surface(z, (0.1, 0.1)))
+    values = areal_parameters(Surface(surfalize_heights(), (0.1, 0.1)))
     expected = {
         "Sa": 0.653132,
         "Sq": 0.745961,

@@ -11,7 +11,13 @@ import os
 import click
 
 #: The options that name a file written beside the report (or instead of one), and their flags.
-SIDE_FILES = {"plot": "--plot", "psd_file": "--psd", "feature_list": "--list", "figure_file": "-o"}
+SIDE_FILES = {
+    "plot": "--plot",
+    "psd_file": "--psd",
+    "feature_list": "--list",
+    "segments": "--segments",
+    "figure_file": "-o",
+}
 
 
 def run_each(work, names, options):

@@ -1,9 +1,11 @@
 """rough features: ISO profile and areal parameters, the amplitude density, the
 slides' feature detection and Rq against evaluation length."""
 
+import dataclasses
+
 import click
 
-from .options import LENGTH, crop_option, plot_option, report_format, surface_input
+from .options import LENGTH, POSITION, RATIO, RATIOS, crop_option, plot_option, report_format, surface_input
 from .report import Report, on_stdout, shown
 
 
@@ -72,6 +74,55 @@ from .report import Report, on_stdout, shown
     help="Write one TSV row per detected feature (SI units); - is standard output, instead of the report.",
 )
 @click.option(
+    "--height",
+    "material_height",
+    type=POSITION,
+    default="0",
+    show_default=True,
+    help="Material ratio Rmr(c)/Smr(c) at this height c about the mean.",
+)
+@click.option(
+    "--ratio",
+    "material_ratio",
+    type=RATIO,
+    default="10",
+    show_default=True,
+    help="Material ratio mr (%) of Rmc(mr)/Smc(mr) and of the volumes Vm(mr), Vv(mr).",
+)
+@click.option(
+    "--dc-ratios",
+    type=RATIOS,
+    default="10:80",
+    show_default=True,
+    help="The two material ratios (%) of the height difference Rδc/Sdc.",
+)
+@click.option(
+    "--volume-ratios",
+    type=RATIOS,
+    default="10:80",
+    show_default=True,
+    help="Maps: the material ratios p:q (%) that split Vmp, Vmc, Vvc and Vvv.",
+)
+@click.option(
+    "--pruning",
+    type=click.FloatRange(0, 100, max_open=True),
+    default=5.0,
+    show_default=True,
+    help="Maps: Wolf pruning of hills and dales lower than this percentage of Sz.",
+)
+@click.option(
+    "--edge-features",
+    type=click.Choice(["exclude", "include"]),
+    default="exclude",
+    show_default=True,
+    help="Maps: leave out, or count, the hills and dales that touch the border or invalid points.",
+)
+@click.option(
+    "--segments",
+    metavar="FILE",
+    help="Maps: write one TSV row per hill and dale (SI units); - is standard output, instead of the report.",
+)
+@click.option(
     "--vs-length", is_flag=True, help="Also report Rq against evaluation length and the slope of log Rq on log L."
 )
 @plot_option(
@@ -91,6 +142,13 @@ def features(
     detect_mode,
     polarity,
     feature_list,
+    material_height,
+    material_ratio,
+    dc_ratios,
+    volume_ratios,
+    pruning,
+    edge_features,
+    segments,
     vs_length,
     plot,
 ):
@@ -99,27 +157,58 @@ def features(
     first to remove form, or give --cutoff for the roughness). Profiles: Ra, Rq,
     Rsk, Rku, Rdq, Rt over the evaluation length; Rp, Rv, Rz per sampling length,
     averaged; RSm; peak density (peaks crossing ±5 % of Rz about the mean line, per
-    mm); Z2 and the Tse–Cruden JRC at --jrc-spacing; and the slides' feature
-    detection. Maps: Sa, Sq, Ssk, Sku, Sp, Sv, Sz, Sdq, Sdr, Sal, Str, Std (ISO
-    25178-2; Std is the lay direction). NaN points are left out.
+    mm); Z2 and the Tse–Cruden JRC at --jrc-spacing; the material-ratio parameters
+    Rmr(c), Rmc(mr), Rδc, Rk, Rpk, Rvk, Mr1, Mr2, A1, A2 (ISO 13565-2) and Rpq, Rvq,
+    Rmq (ISO 13565-3); and the slides' feature detection. Maps: Sa, Sq, Ssk, Sku,
+    Sp, Sv, Sz, Sdq, Sdr, Sal, Str, Std (ISO 25178-2; Std is the lay direction); the
+    functional parameters Smr(c), Smc(mr), Sdc, Sk, Spk, Svk, Smr1, Smr2, Sxp, the
+    volumes Vm, Vv, Vmp, Vmc, Vvc, Vvv and Spq, Svq, Smq; and the feature parameters
+    Spd, Spc, S5p, S5v, S10z, Sda, Sha, Sdv, Shv of the watershed segmentation with
+    Wolf pruning (ISO 25178-2:2021). NaN points are left out.
 
     \b
     Examples:
         rough detrend --order 1 --crop 468um:733um dektak.csv | rough features
         rough features --cutoff 0.8mm --json scan.x3p
         rough features --list features.tsv --plot profile.png rock.tsv
+        rough features --height -1um --ratio 20 --volume-ratios 5:85 scan.x3p
+        rough features --pruning 10 --segments motifs.tsv scan.x3p
         rough features --vs-length rock.tsv
     """
     from .. import metrology
     from ..io.atomic import atomic_output
 
-    report = not on_stdout(list=feature_list, plot=plot)
+    report = not on_stdout(list=feature_list, plot=plot, segments=segments)
     evaluated = surface if cutoff is None else metrology.split(surface, cutoff, "roughness", ends)
+    settings = Settings(
+        cutoff, sampling_lengths, slope, jrc_spacing, along, material_height, material_ratio, dc_ratios, volume_ratios
+    )
+    if segments and (surface.is_profile or along):
+        from ..errors import InputError
+
+        raise InputError("--segments needs a map evaluated as a map, without --along (a profile's features: --list)")
     values = metrology.parameters(
         evaluated, sampling_lengths=sampling_lengths, slope=slope, along=along, jrc_spacing=jrc_spacing
     )
-    table = metrology.PROFILE if surface.is_profile or along else metrology.AREAL
-    rows, document = _parameter_rows(evaluated, values, table, cutoff, sampling_lengths, slope, jrc_spacing, along)
+    functional = metrology.functional_parameters(
+        evaluated,
+        height=material_height,
+        ratio=material_ratio,
+        dc_ratios=dc_ratios,
+        volume_ratios=volume_ratios,
+        along=along,
+    )
+    rows, document = _parameter_rows(evaluated, values, functional, settings)
+    metrology.announce_undefined(functional)
+    if not (surface.is_profile or along):
+        featured, segmentation = _features(evaluated, pruning, edge_features, values["Sz"])
+        metrology.announce_undefined(featured)
+        rows += _value_rows(featured, metrology.FEATURE, {"Spd": segmentation["text"]})
+        document.update(featured)
+        document["evaluation"]["segmentation"] = segmentation["settings"]
+        if segments:
+            with atomic_output(segments) as stream:
+                stream.write(_segment_table(evaluated, pruning).encode())
     found = []
     if surface.is_profile:
         found, detection = _detect(evaluated, detect_cutoff, detect_mode, polarity)
@@ -150,49 +239,141 @@ def features(
     if plot:
         from .. import plots
 
-        plots.save(plots.features_figure(evaluated, found, (centres, density), title=shown(input)), plot)
+        curve = metrology.MaterialRatioCurve(evaluated)
+        figure = plots.features_figure(evaluated, found, (centres, density), curve, title=shown(input))
+        plots.save(figure, plot)
     return Report(rows, document) if report else None
 
 
-def _parameter_rows(surface, values, table, cutoff, sampling_lengths, slope, jrc_spacing, along):
+@dataclasses.dataclass(frozen=True)
+class Settings:
+    """How the parameters were evaluated: the options that shape them."""
+
+    cutoff: float
+    sampling_lengths: int
+    slope: str
+    jrc_spacing: float
+    along: str
+    height: float
+    ratio: float
+    dc_ratios: tuple
+    volume_ratios: tuple
+
+
+def _parameter_rows(surface, values, functional, settings):
     import logging
 
     import numpy as np
 
-    from ..units import format_length, format_quantity
+    from .. import metrology
+    from ..units import format_length
 
     valid = int(np.count_nonzero(~np.isnan(surface.heights)))
     extent = " × ".join(format_length(s) for s in surface.size)
-    basis = f"roughness at λc = {format_length(cutoff)}" if cutoff else "data as given, mean removed"
-    if along:
-        basis += f", profiles along {along}"
+    basis = f"roughness at λc = {format_length(settings.cutoff)}" if settings.cutoff else "data as given, mean removed"
+    if settings.along:
+        basis += f", profiles along {settings.along}"
+    profile = surface.is_profile or settings.along
     evaluation = {
         "points": surface.heights.size,
         "valid_points": valid,
         "size": list(surface.size),
         "basis": basis,
-        "sampling_lengths": sampling_lengths,
-        "slope": slope,
-        "jrc_spacing": jrc_spacing,
-        "cutoff": cutoff,
+        "sampling_lengths": settings.sampling_lengths,
+        "slope": settings.slope,
+        "jrc_spacing": settings.jrc_spacing,
+        "cutoff": settings.cutoff,
+        "material_ratio": {
+            "height": settings.height,
+            "ratio": settings.ratio,
+            "dc_ratios": list(settings.dc_ratios),
+            "volume_ratios": list(settings.volume_ratios),
+        },
     }
+    ratio_units = {"height": "m", "ratio": "%", "dc_ratios": "%", "volume_ratios": "%"}
     units = {"points": "points", "valid_points": "points", "size": "m", "jrc_spacing": "m", "cutoff": "m"}
+    units |= {"material_ratio": ratio_units, "segmentation": {"pruning": "%", "threshold": "m"}}
     rows = [("evaluation", evaluation, units, f"{extent}, {valid} of {surface.heights.size} points valid; {basis}")]
-    for key, (unit, meaning) in table.items():
-        rows.append((key, values[key], unit, f"{format_quantity(values[key], unit):<14} {meaning}"))
-    notes = {
-        "Rz": f"{sampling_lengths} sampling lengths",
-        "Rdq": f"{slope} slope",
-        "Sdq": f"{slope} slope",
-        "JRC": f"Z2 at {format_length(max(jrc_spacing, surface.spacing[0]))} spacing",
-    }
+    notes = _notes(surface, values, settings)
+    rows += _value_rows(values, metrology.PROFILE if profile else metrology.AREAL, notes)
+    rows += _value_rows(functional, metrology.PROFILE_FUNCTIONAL if profile else metrology.AREAL_FUNCTIONAL, notes)
     if "JRC" in values and not 0 <= values["JRC"] <= 20:
-        notes["JRC"] += "; outside the 0–20 range the relation was calibrated on"
         logging.getLogger("rough").warning(
             "JRC = %.4g is outside the 0–20 range the Tse–Cruden relation was calibrated on", values["JRC"]
         )
-    rows = [(k, v, u, f"{t} ({notes[k]})" if k in notes else t) for k, v, u, t in rows]
-    return rows, {**values, "evaluation": evaluation}
+    return rows, {**values, **functional, "evaluation": evaluation}
+
+
+def _value_rows(values, table, notes=None):
+    """A row per parameter of ``table`` (key: (unit, meaning)), its note in brackets."""
+    from ..units import format_quantity
+
+    notes = notes or {}
+    return [
+        (key, values[key], unit, f"{format_quantity(values[key], unit):<14} {meaning}" + _bracket(notes.get(key)))
+        for key, (unit, meaning) in table.items()
+    ]
+
+
+def _bracket(note):
+    return f" ({note})" if note else ""
+
+
+def _notes(surface, values, settings):
+    from ..units import format_length
+
+    c = f"c = {format_length(settings.height)} about the mean"
+    mr = f"mr = {settings.ratio:g} %"
+    dc = f"between {settings.dc_ratios[0]:g} % and {settings.dc_ratios[1]:g} %"
+    pq = f"p = {settings.volume_ratios[0]:g} %, q = {settings.volume_ratios[1]:g} %"
+    notes = {
+        "Rz": f"{settings.sampling_lengths} sampling lengths",
+        "Rdq": f"{settings.slope} slope",
+        "Sdq": f"{settings.slope} slope",
+        "JRC": f"Z2 at {format_length(max(settings.jrc_spacing, surface.spacing[0]))} spacing",
+        "Rmr": c,
+        "Smr": c,
+        "Rmc": mr,
+        "Smc": mr,
+        "Vm": mr,
+        "Vv": mr,
+        "Rdc": dc,
+        "Sdc": dc,
+        **dict.fromkeys(("Vmp", "Vmc", "Vvc", "Vvv"), pq),
+    }
+    if "JRC" in values and not 0 <= values["JRC"] <= 20:
+        notes["JRC"] += "; outside the 0–20 range the relation was calibrated on"
+    return notes
+
+
+def _features(surface, pruning, edges, sz):
+    from ..metrology import feature_parameters
+    from ..units import format_length
+
+    threshold = pruning / 100 * sz
+    settings = {"pruning": pruning, "threshold": threshold, "edges": edges}
+    text = f"Wolf pruning at {pruning:g} % of Sz = {format_length(threshold)}; hills and dales at the edge {edges}d"
+    return feature_parameters(surface, pruning=pruning, edges=edges), {"text": text, "settings": settings}
+
+
+def _segment_table(surface, pruning):
+    from ..metrology import segment
+
+    lines = [
+        f"# rough features: one row per hill and dale (watershed, Wolf pruning at {pruning:g} % of Sz); "
+        "x, y, heights about the mean in m, area in m², volume in m³, curvature in 1/m; edge 1 = touches the "
+        "border or invalid points",
+        "kind\tx\ty\theight\tsaddle\tarea\tvolume\tcurvature\tedge",
+    ]
+    for kind in ("hills", "dales"):
+        lines += [
+            "\t".join(
+                [m.kind, *(repr(float(v)) for v in (m.x, m.y, m.height, m.saddle, m.area, m.volume, m.curvature))]
+                + [str(int(m.edge))]
+            )
+            for m in segment(surface, kind, pruning).motifs
+        ]
+    return "\n".join(lines) + "\n"
 
 
 def _detect(surface, cutoff, mode, polarity):

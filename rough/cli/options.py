@@ -163,12 +163,48 @@ class FrequencyRangeType(click.ParamType):
         return low, high
 
 
+class RatioType(click.ParamType):
+    """A material ratio in per cent, ``10`` or ``10%``, between 0 and 100 → float."""
+
+    name = "PERCENT"
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, float):
+            return value
+        try:
+            ratio = float(str(value).strip().removesuffix("%"))
+        except ValueError:
+            self.fail(f"{value!r} is not a percentage (write e.g. 10 or 10%)", param, ctx)
+        if not 0 <= ratio <= 100:
+            self.fail(f"{value!r}: a material ratio lies between 0 and 100 %", param, ctx)
+        return ratio
+
+
+class RatioPairType(RatioType):
+    """Two increasing material ratios, ``10:80`` (per cent) → (10.0, 80.0)."""
+
+    name = "MR1:MR2"
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, tuple):
+            return value
+        ends = str(value).split(":")
+        if len(ends) != 2:
+            self.fail(f"{value!r}: write two material ratios as MR1:MR2, e.g. 10:80", param, ctx)
+        low, high = (RatioType.convert(self, end, param, ctx) for end in ends)
+        if not low < high:
+            self.fail(f"{value!r}: the first material ratio must be below the second", param, ctx)
+        return low, high
+
+
 POSITION = LengthType()
 LENGTH = PositiveLengthType()
 TIP = TipType()
 SPACING = SpacingType()
 CROP = CropType()
 BAND = FrequencyRangeType()
+RATIO = RatioType()
+RATIOS = RatioPairType()
 
 
 def crop_option(command):

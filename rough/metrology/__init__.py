@@ -1,5 +1,7 @@
 """Metrology: form removal, ISO 16610 Gaussian filters, ISO 4287/25178-2 parameters,
-the source slides' feature detection and the scale dependence of Rq.
+the material-ratio parameters of ISO 13565 and ISO 25178-2, the feature parameters
+of a watershed segmentation, the source slides' feature detection and the scale
+dependence of Rq.
 
 Every function takes and returns SI units (metres) and leaves invalid (NaN) points
 out of fits and statistics; surfaces it returns are NaN where the input was.
@@ -21,34 +23,58 @@ from ..errors import InputError
 from .features import Feature, detect_features
 from .filters import mean_line, split, transmission
 from .form import polynomial_form, remove_form
+from .material_ratio import (
+    AREAL_FUNCTIONAL,
+    PROFILE_FUNCTIONAL,
+    Core,
+    MaterialRatioCurve,
+    ProbabilityFit,
+    functional_parameters,
+)
 from .parameters import (
     AREAL,
     PROFILE,
     amplitude_density,
     areal_parameters,
+    combined,
     joint_roughness_coefficient,
+    map_profiles,
     profile_parameters,
 )
 from .scale import rq_versus_length
+from .segmentation import EDGES, FEATURE, Motif, Segmentation, feature_parameters, segment
 
 KEEP = ("roughness", "waviness", "form")
 log = logging.getLogger("rough")
 
 __all__ = [
     "AREAL",
+    "AREAL_FUNCTIONAL",
+    "EDGES",
+    "FEATURE",
     "KEEP",
     "PROFILE",
+    "PROFILE_FUNCTIONAL",
+    "Core",
     "Feature",
+    "MaterialRatioCurve",
+    "Motif",
+    "ProbabilityFit",
+    "Segmentation",
     "amplitude_density",
+    "announce_undefined",
     "areal_parameters",
     "detect_features",
     "detrend",
+    "feature_parameters",
+    "functional_parameters",
     "mean_line",
     "parameters",
     "polynomial_form",
     "profile_parameters",
     "remove_form",
     "rq_versus_length",
+    "segment",
     "split",
     "transmission",
 ]
@@ -228,7 +254,7 @@ def parameters(surface, cutoff=None, ends="trim", sampling_lengths=5, slope="2po
         values = areal_parameters(evaluated, slope)
     else:
         values = _profiles_of_map(evaluated, along, sampling_lengths, slope, jrc_spacing)
-    _announce_undefined(values)
+    announce_undefined(values)
     return values
 
 
@@ -238,12 +264,21 @@ UNDEFINED = {
     "the profile spans fewer than three JRC spacings": ("Z2",),
     "Z2 is zero or undefined": ("JRC",),
     "no two neighbouring points are valid": ("Rdq", "Sdq", "Sdr"),
+    "fewer than 40 points within ±3 standard deviations": ("Rpq", "Rvq", "Rmq", "Spq", "Svq", "Smq"),
+    "no significant hill clear of the edge and invalid points; on a tilted or curved map, detrend first": (
+        "Spc",
+        "S5p",
+        "Sha",
+        "Shv",
+    ),
+    "no significant dale clear of the edge and invalid points": ("S5v", "Sda", "Sdv"),
+    "S5p or S5v is undefined": ("S10z",),
 }
 
 
-def _announce_undefined(values):
-    """One warning naming each parameter that came out undefined (NaN) and why (Str has
-    its own warning when Sal is defined)."""
+def announce_undefined(values):
+    """One warning naming each parameter of ``values`` that came out undefined (NaN)
+    and why (Str has its own warning when Sal is defined)."""
     undefined = {key for key, value in values.items() if math.isnan(value)}
     if "Str" in undefined and "Sal" not in undefined:
         undefined.discard("Str")
@@ -263,28 +298,7 @@ def _announce_undefined(values):
 
 
 def _profiles_of_map(surface, along, sampling_lengths, slope, jrc_spacing):
-    from ..surface import Surface
-
-    if along not in ("x", "y"):
-        raise InputError(f"along must be x or y, not {along!r}")
-    rows = surface.heights if along == "x" else surface.heights.T
-    spacing = surface.spacing[0 if along == "x" else 1]
-    each = [
-        profile_parameters(Surface(row, (spacing,)), sampling_lengths, slope, jrc_spacing)
-        for row in rows
-        if np.count_nonzero(~np.isnan(row)) > 1
-    ]
-    if not each:
-        raise InputError(f"no profile along {along} has two valid points")
-    combined = {}
-    for key in PROFILE:
-        values = np.array([p[key] for p in each])
-        finite = values[np.isfinite(values)]
-        if not finite.size:
-            combined[key] = float("nan")
-        elif key in ("Rq", "Rdq", "Z2"):
-            combined[key] = float(np.sqrt(np.mean(finite**2)))
-        else:
-            combined[key] = float(np.mean(finite))
-    combined["JRC"] = joint_roughness_coefficient(combined["Z2"])
-    return combined
+    each = [profile_parameters(p, sampling_lengths, slope, jrc_spacing) for p in map_profiles(surface, along)]
+    values = combined(each, PROFILE, quadratic=("Rq", "Rdq", "Z2"))
+    values["JRC"] = joint_roughness_coefficient(values["Z2"])
+    return values

@@ -318,6 +318,35 @@ def areal_parameters(surface, slope="2point", threshold=0.2):
     }
 
 
+def map_profiles(surface, along):
+    """The profiles of a map along ``x`` (its rows) or ``y`` (its columns) that have at
+    least two valid points, as profile Surfaces."""
+    from ..surface import Surface
+
+    if along not in ("x", "y"):
+        raise InputError(f"along must be x or y, not {along!r}")
+    rows = surface.heights if along == "x" else surface.heights.T
+    spacing = surface.spacing[0 if along == "x" else 1]
+    profiles = [Surface(row, (spacing,)) for row in rows if np.count_nonzero(~np.isnan(row)) > 1]
+    if not profiles:
+        raise InputError(f"no profile along {along} has two valid points")
+    return profiles
+
+
+def combined(each, keys, quadratic=()):
+    """One value per key from the dicts ``each``: the mean over the finite values (the
+    quadratic mean for ``quadratic`` keys), NaN when none is finite."""
+    means = {}
+    for key in keys:
+        values = np.array([parameters[key] for parameters in each])
+        finite = values[np.isfinite(values)]
+        if not finite.size:
+            means[key] = math.nan
+        else:
+            means[key] = float(np.sqrt(np.mean(finite**2)) if key in quadratic else np.mean(finite))
+    return means
+
+
 def amplitude_density(surface, bins=50):
     """The amplitude probability density of the heights about their mean.
 

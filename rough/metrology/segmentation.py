@@ -1,0 +1,539 @@
+"""ISO 25178-2 feature parameters: watershed segmentation into hills and dales,
+Wolf pruning, and the parameters of the significant motifs.
+
+Definitions (heights are about the mean of the valid points, as everywhere in
+:mod:`rough.metrology.parameters`; no levelling, no filter):
+
+- Dales are the watershed basins of the heights z, hills those of -z. The map is
+  first cut into one basin per regional minimum (plateaus of equal height count
+  once; 8-connectivity throughout), with scikit-image's ``local_minima`` and
+  ``watershed``.
+- The pour point between two adjacent regions a and b: over all 8-connected
+  neighbouring pairs of points (p in a, q in b), the pour height of the pair is
+  max(z_p, z_q) for dales (min for hills); the saddle between a and b is the lowest
+  of those for dales (the highest for hills). A motif's ``saddle`` is its lowest
+  (dale) / highest (hill) saddle to any neighbour; a motif has none when no other
+  motif touches it.
+- Wolf pruning: a motif's local height is the height from its pit (peak) to its
+  saddle. Repeatedly, the motif of smallest local height below the threshold is
+  merged into the neighbour across its saddle (the deeper pit, higher peak,
+  survives; the motif is the union of the regions). A motif whose local height is
+  at least the threshold stays (``height >= threshold``, as surfalize does); the
+  lowest pit of each connected part of the map always stays. The threshold is
+  ``pruning`` % of Sz, the height range of the valid points (ISO 25178-3's default
+  is 5 %). The merging is done as Kruskal's algorithm over the saddles, lowest
+  first, which gives the same motifs as merging them smallest first (of two
+  equally deep pits, the first in row-major order survives). The surviving pits
+  are the minima of dynamic >= threshold, those of scikit-image's ``h_minima``;
+  it is not used because on floats it can lose a minimum, even the only one, when
+  (m + h + resolution) - m rounds below h, and it keeps both of two equal minima.
+- Each motif has the position and height of its peak (pit) (the first point in
+  row-major order on a plateau), its area (points × dx·dy), its volume above
+  (hills) / below (dales) the level of its saddle, or for a motif with no
+  neighbour its region's lowest (hills) / highest (dales) height, and its peak
+  curvature -½(z_xx + z_yy) by central second differences. It is an ``edge``
+  motif when its region touches the border of the map or an invalid point: such
+  a motif is incomplete.
+- The parameters count the significant hills (dales); with ``edges="exclude"``
+  (the default) the edge motifs are left out. Spd is their number per unit area
+  of the map (nx·dx · ny·dy); Spc the mean curvature of their peaks; S5p the mean
+  height of the five highest peaks and S5v the mean depth of the five deepest pits
+  (fewer when fewer are counted), S10z = S5p + S5v; Sha, Sda the mean area and Shv,
+  Sdv the mean volume of the counted hills, dales.
+
+Invalid (NaN) points belong to no motif (label 0): water does not flow through
+them, so they split motifs as the border does, and the motifs that touch them are
+edge motifs. A part of the map cut off by invalid points has its own motifs.
+"""
+
+import dataclasses
+import math
+
+import numpy as np
+
+from ..errors import InputError
+from .parameters import centred
+
+# key: (unit, what it is), as rough.metrology.parameters.AREAL.
+FEATURE = {
+    "Spd": ("1/m2", "density of peaks: significant hills per area"),
+    "Spc": ("1/m", "arithmetic mean peak curvature"),
+    "S5p": ("m", "five-point peak height"),
+    "S5v": ("m", "five-point pit depth"),
+    "S10z": ("m", "ten-point height S5p + S5v"),
+    "Sda": ("m2", "mean dale area"),
+    "Sha": ("m2", "mean hill area"),
+    "Sdv": ("m3", "mean dale volume"),
+    "Shv": ("m3", "mean hill volume"),
+}
+KINDS = ("hills", "dales")
+EDGES = ("exclude", "include")
+EIGHT = np.ones((3, 3), dtype=bool)
+# one of each pair of opposite 8-neighbours: along x, along y, and the two diagonals
+NEIGHBOURS = (
+    (np.s_[:, :-1], np.s_[:, 1:]),
+    (np.s_[:-1, :], np.s_[1:, :]),
+    (np.s_[:-1, :-1], np.s_[1:, 1:]),
+    (np.s_[:-1, 1:], np.s_[1:, :-1]),
+)
+
+
+@dataclasses.dataclass(frozen=True)
+class Motif:
+    """One significant hill or dale that :func:`segment` found.
+
+    Attributes
+    ----------
+    kind : str
+        ``"hill"`` or ``"dale"``.
+    x, y : float
+        The position of its peak (hill) or pit (dale), metres, in the surface's
+        coordinates (``origin + index * spacing``).
+    height : float
+        The height of the peak or pit about the mean of the valid points, metres (a
+        pit is usually negative).
+    saddle : float
+        The height about the mean of the pass where it meets a neighbour: for a dale
+        the lowest pour point on its boundary, for a hill the highest; NaN when no
+        other motif touches it.
+    area : float
+        Its points × dx·dy, m².
+    volume : float
+        m³: for a hill the volume of material above its base, Σ max(z - base, 0)·dx·dy
+        over its region; for a dale the volume of void below it, Σ max(base - z, 0)·dx·dy.
+        The base is the saddle, or for a motif with no neighbour its region's lowest
+        (hill) or highest (dale) valid height.
+    curvature : float
+        -½(z_xx + z_yy) at the peak or pit by central second differences, 1/m:
+        positive at a peak, negative at a pit; NaN on the border of the map or next
+        to an invalid point.
+    edge : bool
+        True when its region touches the border of the map or an invalid point (an
+        incomplete motif).
+
+    Examples
+    --------
+    >>> from rough.metrology.segmentation import Motif
+    >>> hill = Motif("hill", x=1e-3, y=2e-3, height=5e-6, saddle=1e-6, area=4e-8, volume=5e-14,
+    ...              curvature=40.0, edge=False)
+    >>> f"{(hill.height - hill.saddle) * 1e6:.1f} µm above its saddle"
+    '4.0 µm above its saddle'
+    """
+
+    kind: str
+    x: float
+    y: float
+    height: float
+    saddle: float
+    area: float
+    volume: float
+    curvature: float
+    edge: bool
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class Segmentation:
+    """The significant hills or dales of a map, as :func:`segment` returns them.
+
+    Attributes
+    ----------
+    kind : str
+        ``"hills"`` or ``"dales"``.
+    labels : numpy.ndarray of int
+        Shaped like the heights, ``(ny, nx)``: 0 at invalid points, ``i + 1`` on the
+        region of ``motifs[i]``.
+    motifs : tuple of Motif
+        The significant motifs, in row-major order of their peaks (pits).
+    threshold : float
+        The Wolf pruning height, metres: ``pruning`` % of Sz.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import rough
+    >>> from rough.metrology.segmentation import segment
+    >>> y, x = np.mgrid[0:20, 0:30]
+    >>> bump = np.exp(-((x - 10) ** 2 + (y - 10) ** 2) / 8.0) * 1e-6  # a 1 µm bump
+    >>> hills = segment(rough.Surface(bump, 1e-6))
+    >>> hills.kind, hills.labels.shape, len(hills.motifs), f"{hills.threshold * 1e9:.1f} nm"
+    ('hills', (20, 30), 1, '50.0 nm')
+    >>> bool((hills.labels == 1).all())  # one hill, over the whole map
+    True
+    """
+
+    kind: str
+    labels: np.ndarray
+    motifs: tuple
+    threshold: float
+
+
+def segment(surface, kind="hills", pruning=5.0):
+    """The significant hills or dales of a map, by watershed and Wolf pruning.
+
+    Parameters
+    ----------
+    surface : Surface
+        A map. Invalid (NaN) points belong to no motif: they split motifs as the
+        border does, and a motif that touches one is an edge motif.
+    kind : {"hills", "dales"}, default "hills"
+        Hills are the basins of -z (one per significant peak), dales those of z (one
+        per significant pit).
+    pruning : float, default 5.0
+        The Wolf pruning threshold in % of Sz (the height range of the valid
+        points), in [0, 100): motifs whose height above (below) their saddle is
+        less are merged into a neighbour. 0 keeps every local extreme.
+
+    Returns
+    -------
+    Segmentation
+        The labels of the regions and one :class:`Motif` per significant hill
+        (dale), with the pruning height in metres.
+
+    Raises
+    ------
+    rough.InputError
+        For a profile, a map with no valid points, an unknown ``kind``, or a
+        ``pruning`` outside [0, 100).
+
+    See Also
+    --------
+    feature_parameters : The ISO 25178-2 parameters of these motifs.
+
+    Notes
+    -----
+    The watershed (scikit-image) cuts the map into one region per regional
+    minimum; Wolf pruning then merges them on the graph of regions and saddles
+    (see the module's description). A map of constant height is one motif per
+    connected part.
+
+    Examples
+    --------
+    An egg-box surface, z = A (cos 2πx/λ + cos 2πy/λ), of 4 × 4 periods of 9
+    points, sampled so that each peak falls on a point and the valleys between the
+    hills between points: 16 hills of 9 × 9 points, 4 of them inside the map.
+
+    >>> import numpy as np
+    >>> import rough
+    >>> from rough.metrology.segmentation import segment
+    >>> u = 2 * np.pi * (np.arange(36) - 4) / 9  # a peak at points 4, 13, 22, 31
+    >>> egg_box = rough.Surface(1e-6 * (np.cos(u)[None, :] + np.cos(u)[:, None]), 1e-6)
+    >>> hills = segment(egg_box)
+    >>> len(hills.motifs), sum(not hill.edge for hill in hills.motifs)
+    (16, 4)
+    >>> sorted({round(hill.area / 1e-12) for hill in hills.motifs})  # µm²
+    [81]
+    >>> peak = hills.motifs[5]
+    >>> print(f"peak at x = {peak.x * 1e6:.0f} µm, y = {peak.y * 1e6:.0f} µm, {peak.height * 1e6:.3f} µm high")
+    peak at x = 13 µm, y = 13 µm, 2.000 µm high
+
+    A hole of invalid points makes the hill around it an edge motif:
+
+    >>> egg_box.heights[12:15, 12:15] = np.nan
+    >>> hills = segment(egg_box)
+    >>> hills.motifs[5].edge, int(hills.labels[13, 13])
+    (True, 0)
+    """
+    levels, valid = _map(surface)
+    if kind not in KINDS:
+        raise InputError(f"kind must be one of {', '.join(KINDS)}, not {kind!r}")
+    pruning = _pruning(pruning)
+    image = -levels if kind == "hills" else levels
+    low, high = float(image[valid].min()), float(image[valid].max())
+    threshold = pruning * (high - low) / 100.0
+    filled = np.where(valid, image, high)  # invalid points never make a minimum
+    labels, count = _basins(filled, valid)
+    regions = _regions(filled, labels, count)
+    lut, roots = _prune(regions, threshold)
+    labels = lut[labels]
+    motifs = _motifs(surface, kind, filled, labels, lut, roots, regions)
+    return Segmentation(kind, labels, motifs, threshold)
+
+
+def feature_parameters(surface, pruning=5.0, edges="exclude"):
+    """ISO 25178-2 feature parameters of a map: Spd, Spc, S5p, S5v, S10z, Sda, Sha,
+    Sdv, Shv.
+
+    On the data as given, about the mean of the valid points (no levelling, no
+    filter: detrend or filter first if you want them).
+
+    Parameters
+    ----------
+    surface : Surface
+        A map. Invalid (NaN) points belong to no motif; the motifs that touch them
+        are edge motifs, left out with ``edges="exclude"``. Spd's area is that of
+        the whole map, invalid points included.
+    pruning : float, default 5.0
+        The Wolf pruning threshold in % of Sz, in [0, 100) (ISO 25178-3's default).
+    edges : {"exclude", "include"}, default "exclude"
+        Whether the motifs that touch the border of the map or an invalid point
+        (incomplete motifs) are counted.
+
+    Returns
+    -------
+    dict of str to float
+        Keyed as :data:`FEATURE`: Spd (1/m²), Spc (1/m), S5p, S5v, S10z (m), Sda,
+        Sha (m²), Sdv, Shv (m³). Spd is 0 when no hill is counted; the others are
+        NaN where they are undefined: with no counted hill (Spc, S5p, Sha, Shv) or
+        dale (S5v, Sda, Sdv), S10z unless both S5p and S5v are defined, and Spc when
+        no counted peak is away from the border and invalid points.
+
+    Raises
+    ------
+    rough.InputError
+        For a profile, a map with no valid points, an unknown ``edges``, or a
+        ``pruning`` outside [0, 100).
+
+    See Also
+    --------
+    segment : The hills and dales themselves.
+    rough.metrology.areal_parameters : The other ISO 25178-2 parameters.
+
+    Notes
+    -----
+    With ``edges="exclude"`` a map that holds only one hill across its whole area
+    (a single bump) has no complete hill: Spd = 0 and S5p is NaN;
+    ``edges="include"`` counts it.
+
+    Examples
+    --------
+    The egg-box surface of :func:`segment`, A = 1 µm: 4 complete hills and 9
+    complete dales on 36 µm × 36 µm, the peaks 2 µm high, the pits (between points)
+    2 cos(π/9) µm deep.
+
+    >>> import numpy as np
+    >>> import rough
+    >>> from rough.metrology.segmentation import feature_parameters
+    >>> u = 2 * np.pi * (np.arange(36) - 4) / 9
+    >>> egg_box = rough.Surface(1e-6 * (np.cos(u)[None, :] + np.cos(u)[:, None]), 1e-6)
+    >>> values = feature_parameters(egg_box)
+    >>> print(f"Spd {values['Spd'] * 36e-6**2:.0f} per map, S5p {values['S5p'] * 1e6:.3f} µm, "
+    ...       f"S5v {values['S5v'] * 1e6:.3f} µm, S10z {values['S10z'] * 1e6:.3f} µm")
+    Spd 4 per map, S5p 2.000 µm, S5v 1.879 µm, S10z 3.879 µm
+    >>> print(f"Sha {values['Sha'] * 1e12:.0f} µm², Shv {values['Shv'] * 1e18:.1f} µm³")
+    Sha 81 µm², Shv 30.7 µm³
+    """
+    if edges not in EDGES:
+        raise InputError(f"edges must be one of {', '.join(EDGES)}, not {edges!r}")
+    hills = _counted(segment(surface, "hills", pruning), edges)
+    dales = _counted(segment(surface, "dales", pruning), edges)
+    nx, ny = surface.points
+    dx, dy = surface.spacing
+    curvatures = [hill.curvature for hill in hills if math.isfinite(hill.curvature)]
+    s5p = _mean(sorted((hill.height for hill in hills), reverse=True)[:5])
+    s5v = _mean(sorted((-dale.height for dale in dales), reverse=True)[:5])
+    return {
+        "Spd": len(hills) / (nx * dx * ny * dy),
+        "Spc": _mean(curvatures),
+        "S5p": s5p,
+        "S5v": s5v,
+        "S10z": s5p + s5v,
+        "Sda": _mean([dale.area for dale in dales]),
+        "Sha": _mean([hill.area for hill in hills]),
+        "Sdv": _mean([dale.volume for dale in dales]),
+        "Shv": _mean([hill.volume for hill in hills]),
+    }
+
+
+def _map(surface):
+    """The heights about the mean of the valid points, and the valid mask, of a map."""
+    if surface.is_profile:
+        raise InputError("feature parameters need a map, not a profile")
+    valid = ~np.isnan(surface.heights)
+    if not valid.any():
+        raise InputError("no valid points: nothing to segment")
+    return centred(surface.heights), valid
+
+
+def _pruning(pruning):
+    try:
+        pruning = float(pruning)
+    except (TypeError, ValueError):
+        raise InputError(f"pruning must be a number (% of Sz), not {pruning!r}") from None
+    if not 0.0 <= pruning < 100.0:
+        raise InputError(f"pruning must be at least 0 and less than 100 (% of Sz), not {pruning:g}")
+    return pruning
+
+
+def _basins(filled, valid):
+    """One watershed region per regional minimum of ``filled`` (8-connected), within
+    ``valid``; a connected part of the valid points without a minimum (a constant
+    one) gets one at its lowest point. Returns the labels (0 outside) and their count."""
+    from scipy import ndimage
+    from skimage.morphology import local_minima
+    from skimage.segmentation import watershed
+
+    minima = local_minima(filled, connectivity=2, allow_borders=True) & valid
+    markers, count = ndimage.label(minima, structure=EIGHT)
+    parts, part_count = ndimage.label(valid, structure=EIGHT)
+    marked = np.zeros(part_count + 1, dtype=bool)
+    marked[parts[minima]] = True
+    missing = np.flatnonzero(~marked[1:]) + 1
+    for position in ndimage.minimum_position(filled, parts, missing) if missing.size else ():
+        count += 1
+        markers[position] = count
+    return watershed(filled, markers, connectivity=2, mask=valid), count
+
+
+def _regions(filled, labels, count):
+    """Per region (index 1..count; index 0 is the invalid points): the lowest value and
+    the index of its first point in row-major order, the highest value, the number of
+    points, whether it touches the border or an invalid point; and the pairs of
+    8-neighbouring points in different regions with their pour heights."""
+    flat_labels, flat = labels.ravel(), filled.ravel()
+    low = np.full(count + 1, np.inf)
+    np.minimum.at(low, flat_labels, flat)
+    high = np.full(count + 1, -np.inf)
+    np.maximum.at(high, flat_labels, flat)
+    lowest = np.flatnonzero((flat == low[flat_labels]) & (flat_labels > 0))
+    pit = np.zeros(count + 1, dtype=np.int64)
+    owners, first_index = np.unique(flat_labels[lowest], return_index=True)
+    pit[owners] = lowest[first_index]  # the first lowest point in row-major order
+    edge = np.zeros(count + 1, dtype=bool)
+    for border in (labels[0], labels[-1], labels[:, 0], labels[:, -1]):
+        edge[border] = True
+    first, second, pour = [], [], []
+    for one, other in NEIGHBOURS:
+        a, b = labels[one], labels[other]
+        differ = a != b
+        a, b = a[differ], b[differ]
+        heights = np.maximum(filled[one][differ], filled[other][differ])
+        inside = (a > 0) & (b > 0)
+        edge[a[~inside]] = True  # one side is an invalid point (label 0)
+        edge[b[~inside]] = True
+        first.append(a[inside])
+        second.append(b[inside])
+        pour.append(heights[inside])
+    edge[0] = False
+    return {
+        "low": low,
+        "high": high,
+        "pit": pit,
+        "area": np.bincount(flat_labels, minlength=count + 1),
+        "edge": edge,
+        "first": np.concatenate(first),
+        "second": np.concatenate(second),
+        "pour": np.concatenate(pour),
+    }
+
+
+def _prune(regions, threshold):
+    """Wolf pruning on the graph of regions. Returns the lookup table from region
+    labels to motif labels (0 stays 0; motifs numbered in row-major order of their
+    pits) and, for each motif label, the region whose pit is its pit.
+
+    Kruskal's algorithm over the saddles, lowest first: at each saddle between two
+    motifs, the one with the higher pit is merged into the other when its height
+    below the saddle is less than ``threshold`` (all its lower saddles have been
+    seen, so this saddle is its lowest). Saddles that cannot merge anything (their
+    height above the higher of the two regions' own pits is at least the
+    threshold) are left out of the loop."""
+    low, pit = regions["low"], regions["pit"]
+    first, second, pour = regions["first"], regions["second"], regions["pour"]
+    count = low.size - 1
+    near = pour - np.maximum(low[first], low[second]) < threshold
+    one, other = np.minimum(first[near], second[near]), np.maximum(first[near], second[near])
+    parent = np.arange(count + 1)
+    if one.size:
+        key = one.astype(np.int64) * (count + 1) + other
+        order = np.argsort(key, kind="stable")
+        key, heights = key[order], pour[near][order]
+        starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
+        saddles = np.minimum.reduceat(heights, starts)
+        one, other = np.divmod(key[starts], count + 1)
+        order = np.lexsort((other, one, saddles))
+        parent = _kruskal(one[order], other[order], saddles[order], low, pit, threshold, count)
+    while True:
+        grand = parent[parent]
+        if np.array_equal(grand, parent):
+            break
+        parent = grand
+    roots = np.unique(parent[1:])
+    roots = roots[np.argsort(pit[roots], kind="stable")]
+    numbers = np.zeros(count + 1, dtype=np.int64)
+    numbers[roots] = np.arange(1, roots.size + 1)
+    return numbers[parent], np.r_[0, roots]
+
+
+def _kruskal(one, other, saddles, low, pit, threshold, count):
+    """The union-find forest of :func:`_prune` (a loop over saddles, not points)."""
+    parent = list(range(count + 1))
+    depth, place = low.tolist(), pit.tolist()
+
+    def find(a):
+        while parent[a] != a:
+            parent[a] = parent[parent[a]]
+            a = parent[a]
+        return a
+
+    for a, b, saddle in zip(one.tolist(), other.tolist(), saddles.tolist()):
+        a, b = find(a), find(b)
+        if a == b:
+            continue
+        if (depth[b], place[b]) < (depth[a], place[a]):
+            a, b = b, a
+        if saddle - depth[b] < threshold:
+            parent[b] = a
+    return np.array(parent)
+
+
+def _motifs(surface, kind, filled, labels, lut, roots, regions):
+    """The :class:`Motif` of each label of ``labels`` (the pruned regions, whose pits
+    are those of the regions ``roots``)."""
+    count = roots.size - 1
+    members = lut[1:]
+    area = np.bincount(members, weights=regions["area"][1:], minlength=count + 1)
+    edge = np.bincount(members, weights=regions["edge"][1:], minlength=count + 1) > 0
+    high = np.full(count + 1, -np.inf)
+    np.maximum.at(high, members, regions["high"][1:])
+    one, other = lut[regions["first"]], lut[regions["second"]]
+    across = one != other
+    pour = regions["pour"][across]
+    saddle = np.full(count + 1, np.inf)
+    np.minimum.at(saddle, one[across], pour)
+    np.minimum.at(saddle, other[across], pour)
+    base = np.where(np.isfinite(saddle), saddle, high)
+    below = np.maximum(base[labels] - filled, 0.0)
+    dx, dy = surface.spacing
+    volume = np.bincount(labels.ravel(), weights=below.ravel(), minlength=count + 1) * (dx * dy)
+    rows, columns = np.divmod(regions["pit"][roots], filled.shape[1])
+    curvature = _curvature(surface.heights, rows, columns, dx, dy)
+    sign = -1.0 if kind == "hills" else 1.0
+    depth = regions["low"][roots]
+    x0, y0 = surface.origin
+    return tuple(
+        Motif(
+            kind=kind[:-1],
+            x=x0 + int(columns[n]) * dx,
+            y=y0 + int(rows[n]) * dy,
+            height=sign * float(depth[n]) + 0.0,
+            saddle=sign * float(saddle[n]) + 0.0 if math.isfinite(saddle[n]) else math.nan,
+            area=float(area[n]) * dx * dy,
+            volume=float(volume[n]),
+            curvature=float(curvature[n]),
+            edge=bool(edge[n]),
+        )
+        for n in range(1, count + 1)
+    )
+
+
+def _curvature(heights, rows, columns, dx, dy):
+    """-½(z_xx + z_yy) by central second differences at the points (rows, columns);
+    NaN on the border or next to an invalid point."""
+    ny, nx = heights.shape
+    if nx < 3 or ny < 3:
+        return np.full(rows.shape, np.nan)
+    inside = (rows > 0) & (rows < ny - 1) & (columns > 0) & (columns < nx - 1)
+    i, j = np.clip(rows, 1, ny - 2), np.clip(columns, 1, nx - 2)
+    centre = heights[i, j]
+    zxx = (heights[i, j - 1] - 2.0 * centre + heights[i, j + 1]) / dx**2
+    zyy = (heights[i - 1, j] - 2.0 * centre + heights[i + 1, j]) / dy**2
+    return np.where(inside, -0.5 * (zxx + zyy), np.nan)
+
+
+def _counted(segmentation, edges):
+    """The motifs the parameters count: all, or those that are not edge motifs."""
+    return [motif for motif in segmentation.motifs if edges == "include" or not motif.edge]
+
+
+def _mean(values):
+    return float(np.mean(values)) if len(values) else math.nan
