@@ -96,6 +96,7 @@ bench: $(BIN)/.installed
 	$(BIN)/python bench/bench_tip.py
 	$(BIN)/python bench/bench_scaling.py
 	$(BIN)/python bench/bench_batch.py
+	$(BIN)/python bench/bench_tribology.py
 
 fuzz: $(BIN)/.installed
 	$(BIN)/python -m pip install --quiet atheris
