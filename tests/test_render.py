@@ -15,7 +15,7 @@ from rough.fractal.resample import resample
 from rough.fractal.synth import synthesize_fragments, synthesize_profile
 from rough.render import DynamicStylus, QuasiStatic, Settings, Track, clamp, forces, run, simulate, write_trace
 from rough.render.friction import CoulombViscous, Dahl, Karnopp, parse_friction
-from rough.render.loop import LoopStalled
+from rough.render.loop import LoopStalled, _Watchdog
 
 from conftest import assert_one_line_error, rough
 
@@ -231,8 +231,10 @@ class ScriptedDevice:
     def read(self):
         if self.k == self.fail_at:
             raise self.error()
-        if self.k == self.stall_at:
-            time.sleep(0.4)
+        if self.k == self.stall_at:  # stalls until the watchdog stops the device (at most 10 s)
+            until = time.monotonic() + 10
+            while not self.stopped and time.monotonic() < until:
+                time.sleep(1e-3)
         return self.positions[min(self.k, len(self.positions) - 1)]
 
     def write(self, fx, fy):
@@ -291,16 +293,73 @@ def test_the_watchdog_zeroes_the_force_when_the_loop_stalls():
     assert device.written[-1] == (0.0, 0.0) and len(device.written) < 60
 
 
-def test_the_real_time_loop_keeps_its_rate():
+class FakeClock:
+    """A controllable clock for the real-time loop: each reading costs ``step`` seconds
+    and a sleep advances it exactly (so the pacing logic is tested, not the machine)."""
+
+    def __init__(self, step=1e-6):
+        self.now, self.step = 0.0, step
+
+    def perf_counter(self):
+        self.now += self.step
+        return self.now
+
+    def sleep(self, seconds):
+        self.now += max(seconds, 0.0)
+
+
+class SlowDevice(ScriptedDevice):
+    """Its read at tick ``slow_at`` takes ``delay`` seconds of the fake clock."""
+
+    def __init__(self, clock, slow_at, delay):
+        super().__init__([(5e-3, -1e-3, 0)])
+        self.clock, self.slow_at, self.delay = clock, slow_at, delay
+
+    def read(self):
+        if self.k == self.slow_at:
+            self.clock.sleep(self.delay)
+        return super().read()
+
+
+@pytest.fixture
+def fake_clock(monkeypatch):
+    clock = FakeClock()
+    monkeypatch.setattr(time, "perf_counter", clock.perf_counter)
+    monkeypatch.setattr(time, "sleep", clock.sleep)
+    return clock
+
+
+def test_the_real_time_loop_keeps_its_rate(fake_clock):
     device = ScriptedDevice([(5e-3, -1e-3, 0)])
     timing = run(device, [FLAT], QuasiStatic(), None, Settings(duration=0.3, realtime=True)).timing()
-    assert timing["rate"] == pytest.approx(1000.0, rel=0.02)
-    assert timing["jitter_p50"] < 1e-4
+    assert timing["ticks"] == 300 and timing["missed_deadlines"] == 0
+    assert timing["rate"] == pytest.approx(1000.0, rel=1e-4)
+    assert timing["jitter_max"] < 5e-6 and timing["max_lateness"] < 5e-6  # a few readings of the clock
 
 
-def test_simulation_runs_much_faster_than_real_time():
-    result = simulate(rock_track(), 0.02)
-    assert result.timing()["realtime_factor"] > 50  # bench/bench_render.py measures it properly
+def test_a_late_tick_skips_the_deadlines_it_missed(fake_clock):
+    """A read that takes 3.5 periods: the loop does not try to catch up with a burst of
+    ticks; it counts the two deadlines it missed and resumes on the grid."""
+    device = SlowDevice(fake_clock, slow_at=100, delay=3.5e-3)
+    result = run(device, [FLAT], QuasiStatic(), None, Settings(duration=0.3, realtime=True))
+    timing = result.timing()
+    assert timing["ticks"] == 300 and timing["missed_deadlines"] == 2
+    # the tick after the slow read starts at once, 0.5 ms after its (latest) deadline;
+    # the next one waits for its deadline on the grid again
+    assert timing["max_lateness"] == pytest.approx(0.5e-3, abs=1e-5)
+    late = np.flatnonzero(result.starts - result.deadlines > 5e-6)
+    assert late.tolist() == [101]
+    assert timing["wall_time"] == pytest.approx(0.301, abs=2e-5)  # the last tick starts at 301 ms: two slots skipped
+
+
+def test_the_watchdog_trips_when_the_tick_stops_for_longer_than_its_timeout():
+    device = ScriptedDevice([(5e-3, -1e-3, 0)])
+    watchdog = _Watchdog(device, 2e-3)
+    assert not watchdog.look(0.0)  # the first look notes the tick
+    watchdog.tick = 1
+    assert not watchdog.look(1.0e-3)  # the tick moved: the count starts again
+    assert not watchdog.look(2.9e-3) and not device.stopped  # 1.9 ms without a tick
+    assert watchdog.look(3.1e-3) and device.stopped and device.written[-1] == (0.0, 0.0)
 
 
 def test_trace_files(tmp_path):
@@ -408,8 +467,8 @@ class TimedDevice(ScriptedDevice):
 
     def read(self):
         if self.k == self.spin_at:
-            until = time.monotonic() + 0.3
-            while time.monotonic() < until:  # stuck in Python code, holding the interpreter
+            until = time.monotonic() + 10
+            while not self.stopped and time.monotonic() < until:  # stuck in Python code, holding the interpreter
                 pass
         return super().read()
 
@@ -483,18 +542,17 @@ def test_an_exception_zeroes_the_force_at_once(monkeypatch):
     assert readings.count((25, 26)) <= 1
 
 
-def test_a_stalled_loop_is_zeroed_within_two_ticks_of_its_watchdog():
-    """The loop gets stuck in Python code; with --watchdog 2ms (two ticks) the force is
-    zeroed within two ticks of the watchdog's deadline, though the loop holds the
-    interpreter, and nothing is written after."""
+def test_a_stalled_loop_is_zeroed_by_its_watchdog():
+    """The loop gets stuck in Python code, holding the interpreter; the watchdog thread
+    still gets it and zeroes the force, and nothing is written after. (How soon is the
+    watchdog's own logic, tested against a controllable clock above; bench/bench_render.py
+    measures it on the machine.)"""
     device = TimedDevice([(5e-3, -1e-3, 0)], spin_at=30)
     device.needs_watchdog = True
     with pytest.raises(LoopStalled):
         run(device, [FLAT], QuasiStatic(), None, Settings(duration=2.0, watchdog=2e-3, realtime=True))
     stop = device.written.index((0.0, 0.0))
     assert stop == 30 and all(f[1] > 0 for f in device.written[:30])
-    stalled = device.times[29] + 1e-3  # the deadline of the tick that never came
-    assert device.times[30] - stalled < 2e-3 + 2e-3
     assert all(f == (0.0, 0.0) for f in device.written[30:])
 
 

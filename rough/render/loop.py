@@ -216,17 +216,23 @@ class _Watchdog(threading.Thread):
         super().__init__(name="rough-render-watchdog", daemon=True)
         self.device, self.timeout = device, timeout
         self.tick, self.tripped = 0, False
+        self._last, self._changed = -1, 0.0
         self._done = threading.Event()
 
     def run(self):
-        last, changed = -1, time.monotonic()
         while not self._done.wait(self.timeout / 8):
-            if self.tick != last:
-                last, changed = self.tick, time.monotonic()
-            elif time.monotonic() - changed > self.timeout:
-                self.tripped = True
-                self.device.emergency_stop()
+            if self.look(time.monotonic()):
                 return
+
+    def look(self, now):
+        """One look at the loop at the time ``now`` (seconds): True, with the device
+        stopped, when its tick has not advanced for more than the timeout."""
+        if self.tick != self._last:
+            self._last, self._changed = self.tick, now
+        elif now - self._changed > self.timeout:
+            self.tripped = True
+            self.device.emergency_stop()
+        return self.tripped
 
     def stop(self):
         self._done.set()
