@@ -201,14 +201,16 @@ def features(
     rows, document = _parameter_rows(evaluated, values, functional, settings)
     metrology.announce_undefined(functional)
     if not (surface.is_profile or along):
-        featured, segmentation = _features(evaluated, pruning, edge_features, values["Sz"])
+        hills, dales = (metrology.segment(evaluated, kind, pruning) for kind in ("hills", "dales"))
+        featured = metrology.motif_parameters(evaluated, hills, dales, edge_features)
         metrology.announce_undefined(featured)
+        segmentation = _segmentation(pruning, edge_features, values["Sz"])
         rows += _value_rows(featured, metrology.FEATURE, {"Spd": segmentation["text"]})
         document.update(featured)
         document["evaluation"]["segmentation"] = segmentation["settings"]
         if segments:
             with atomic_output(segments) as stream:
-                stream.write(_segment_table(evaluated, pruning).encode())
+                stream.write(_segment_table(hills, dales, pruning).encode())
     found = []
     if surface.is_profile:
         found, detection = _detect(evaluated, detect_cutoff, detect_mode, polarity)
@@ -346,32 +348,29 @@ def _notes(surface, values, settings):
     return notes
 
 
-def _features(surface, pruning, edges, sz):
-    from ..metrology import feature_parameters
+def _segmentation(pruning, edges, sz):
     from ..units import format_length
 
     threshold = pruning / 100 * sz
     settings = {"pruning": pruning, "threshold": threshold, "edges": edges}
     text = f"Wolf pruning at {pruning:g} % of Sz = {format_length(threshold)}; hills and dales at the edge {edges}d"
-    return feature_parameters(surface, pruning=pruning, edges=edges), {"text": text, "settings": settings}
+    return {"text": text, "settings": settings}
 
 
-def _segment_table(surface, pruning):
-    from ..metrology import segment
-
+def _segment_table(hills, dales, pruning):
     lines = [
         f"# rough features: one row per hill and dale (watershed, Wolf pruning at {pruning:g} % of Sz); "
         "x, y, heights about the mean in m, area in m², volume in m³, curvature in 1/m; edge 1 = touches the "
         "border or invalid points",
         "kind\tx\ty\theight\tsaddle\tarea\tvolume\tcurvature\tedge",
     ]
-    for kind in ("hills", "dales"):
+    for segmentation in (hills, dales):
         lines += [
             "\t".join(
                 [m.kind, *(repr(float(v)) for v in (m.x, m.y, m.height, m.saddle, m.area, m.volume, m.curvature))]
                 + [str(int(m.edge))]
             )
-            for m in segment(surface, kind, pruning).motifs
+            for m in segmentation.motifs
         ]
     return "\n".join(lines) + "\n"
 

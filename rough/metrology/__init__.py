@@ -42,7 +42,7 @@ from .parameters import (
     profile_parameters,
 )
 from .scale import rq_versus_length
-from .segmentation import EDGES, FEATURE, Motif, Segmentation, feature_parameters, segment
+from .segmentation import EDGES, FEATURE, Motif, Segmentation, feature_parameters, motif_parameters, segment
 
 KEEP = ("roughness", "waviness", "form")
 log = logging.getLogger("rough")
@@ -68,6 +68,7 @@ __all__ = [
     "detrend",
     "feature_parameters",
     "functional_parameters",
+    "motif_parameters",
     "mean_line",
     "parameters",
     "polynomial_form",

@@ -312,10 +312,42 @@ def feature_parameters(surface, pruning=5.0, edges="exclude"):
     >>> print(f"Sha {values['Sha'] * 1e12:.0f} µm², Shv {values['Shv'] * 1e18:.1f} µm³")
     Sha 81 µm², Shv 30.7 µm³
     """
-    if edges not in EDGES:
-        raise InputError(f"edges must be one of {', '.join(EDGES)}, not {edges!r}")
-    hills = _counted(segment(surface, "hills", pruning), edges)
-    dales = _counted(segment(surface, "dales", pruning), edges)
+    _check_edges(edges)
+    return motif_parameters(surface, segment(surface, "hills", pruning), segment(surface, "dales", pruning), edges)
+
+
+def motif_parameters(surface, hills, dales, edges="exclude"):
+    """The feature parameters of a map from its hills and dales already segmented, as
+    :func:`feature_parameters` computes them (for a caller that also wants the
+    motifs themselves, without segmenting twice).
+
+    Parameters
+    ----------
+    surface : Surface
+        The map that was segmented.
+    hills, dales : Segmentation
+        What :func:`segment` returned for ``"hills"`` and ``"dales"``.
+    edges : {"exclude", "include"}, default "exclude"
+        Whether the edge motifs are counted.
+
+    Returns
+    -------
+    dict of str to float
+        As :func:`feature_parameters`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import rough
+    >>> from rough.metrology.segmentation import feature_parameters, motif_parameters, segment
+    >>> u = 2 * np.pi * (np.arange(36) - 4) / 9
+    >>> egg_box = rough.Surface(1e-6 * (np.cos(u)[None, :] + np.cos(u)[:, None]), 1e-6)
+    >>> hills, dales = segment(egg_box, "hills"), segment(egg_box, "dales")
+    >>> motif_parameters(egg_box, hills, dales) == feature_parameters(egg_box)
+    True
+    """
+    _check_edges(edges)
+    hills, dales = _counted(hills, edges), _counted(dales, edges)
     nx, ny = surface.points
     dx, dy = surface.spacing
     curvatures = [hill.curvature for hill in hills if math.isfinite(hill.curvature)]
@@ -528,6 +560,11 @@ def _curvature(heights, rows, columns, dx, dy):
     zxx = (heights[i, j - 1] - 2.0 * centre + heights[i, j + 1]) / dx**2
     zyy = (heights[i - 1, j] - 2.0 * centre + heights[i + 1, j]) / dy**2
     return np.where(inside, -0.5 * (zxx + zyy), np.nan)
+
+
+def _check_edges(edges):
+    if edges not in EDGES:
+        raise InputError(f"edges must be one of {', '.join(EDGES)}, not {edges!r}")
 
 
 def _counted(segmentation, edges):
