@@ -230,14 +230,21 @@ class MaterialRatioCurve:
         k = np.clip(np.searchsorted(self.ratios, ratio, side="right") - 1, 0, self.ratios.size - 2)
         return self._integral[k] + (ratio - self.ratios[k]) * (self.heights[k] + self.height_at(ratio)) / 2
 
+    def _excess(self, ratio, level):
+        """``∫_0^ratio (h(q) - level) dq``: the curve above ``level`` up to ``ratio`` (height × %)."""
+        return max(0.0, float(self._area_above(ratio) - ratio * level))
+
+    def _deficit(self, ratio, level):
+        """``∫_ratio^100 (level - h(q)) dq``: the curve below ``level`` from ``ratio`` (height × %)."""
+        return max(0.0, float((100.0 - ratio) * level - (self._integral[-1] - self._area_above(ratio))))
+
     def material_volume(self, ratio):
         """Vm(mr): the material above the height Smc(mr), per unit area, m³/m²."""
-        return max(0.0, float(self._area_above(ratio) - ratio * self.height_at(ratio)) / 100.0)
+        return self._excess(ratio, self.height_at(ratio)) / 100.0
 
     def void_volume(self, ratio):
         """Vv(mr): the void below the height Smc(mr), per unit area, m³/m²."""
-        below = self._integral[-1] - self._area_above(ratio)
-        return max(0.0, float((100.0 - ratio) * self.height_at(ratio) - below) / 100.0)
+        return self._deficit(ratio, self.height_at(ratio)) / 100.0
 
     def core(self):
         """The ISO 13565-2 construction: the 40 % central region of least secant
@@ -259,8 +266,7 @@ class MaterialRatioCurve:
             intercept = float(self.heights[first]) - slope * start
         top, bottom = intercept, intercept + 100.0 * slope
         mr1, mr2 = float(self._ratio(top, "left")), float(self._ratio(bottom, "right"))
-        peak_area = max(0.0, float(self._area_above(mr1) - mr1 * top))
-        valley_area = max(0.0, float((100.0 - mr2) * bottom - (self._integral[-1] - self._area_above(mr2))))
+        peak_area, valley_area = self._excess(mr1, top), self._deficit(mr2, bottom)
         return Core(top, bottom, slope, (start, start + CENTRAL_REGION), mr1, mr2, peak_area, valley_area)
 
     def probability(self):
