@@ -96,6 +96,13 @@ def test_netcdf_without_sizes_needs_spacing(tmp_path):
     assert read(path, spacing=1e-6).spacing == (1e-6, 1e-6)
 
 
+def test_netcdf_with_an_empty_dimension_is_refused(tmp_path):
+    """A dimension of length 0 (found by the fuzz test): one line, not a division by zero."""
+    path = _netcdf(tmp_path, np.ones((0, 4)), length=(6.0, 2.0))
+    with pytest.raises(FormatError, match="holds no points"):
+        read(path)
+
+
 def test_netcdf_nonuniform_profile_needs_regrid(tmp_path):
     path = _netcdf(tmp_path, np.array([0.0, 1.0, 3.0, 2.0]), nonuniform_x=[0.0, 1.0, 3.0, 4.0])
     with pytest.raises(FormatError, match="--regrid"):

@@ -18,7 +18,8 @@ row high is a profile. A file with no data field but a graph gives the first cur
 is refused. The reader is rough's own, bounded by the file's size (gwyfile's reader trusts lengths and can loop
 forever on a damaged file).
 
-Writing (with gwyfile): channel 0 in metres, titled by the metadata's ``title`` (else "Height"); NaN points are
+Writing (with gwyfile): channel 0 in metres, titled by the metadata's ``title`` less any NUL characters (GWY
+strings end at NUL; the full title travels in ``rough.metadata``), else "Height"; NaN points are
 filled with the mean of the valid ones (a data field cannot hold NaN) and marked in ``/0/mask``, as Gwyddion's own
 importers do. A profile is written as a field one row high, so NaN points keep their place. rough's units, metadata
 and history are the strings ``rough.units``, ``rough.metadata`` and ``rough.history`` (JSON) in ``/0/meta``, which
@@ -264,7 +265,7 @@ def write(surface, stream):
     shape = {"xreal": heights.shape[1] * dx, "yreal": heights.shape[0] * dy, "xoff": x0, "yoff": y0}
     container = objects.GwyContainer()
     container["/0/data"] = objects.GwyDataField(filled, **shape, si_unit_xy="m", si_unit_z="m")
-    container["/0/data/title"] = str(surface.metadata.get("title") or "Height")
+    container["/0/data/title"] = str(surface.metadata.get("title") or "").replace("\0", "") or "Height"
     if not valid.all():
         container["/0/mask"] = objects.GwyDataField((~valid).astype(np.float64), **shape, si_unit_xy="m")
     record = {f"rough.{part}": text for part, text in provenance.record(surface).items()}

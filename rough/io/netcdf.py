@@ -52,6 +52,8 @@ def _surface(nc, options):
         raise FormatError(f"NetCDF 'heights' has {len(dims)} dimensions; rough reads 1 (profile) or 2 (map)")
     heights = np.array(heights_var.data, dtype=np.float64)
     check_size(heights.shape, "the NetCDF heights")
+    if not heights.size:
+        raise FormatError(f"NetCDF 'heights' holds no points (shape {heights.shape})")
     if "mask" in variables:
         mask = np.asarray(variables["mask"].data)
         if mask.shape != heights.shape:
