@@ -9,7 +9,7 @@ BIN = $(VENV)/bin
 DEMO = build/demo
 SOURCES = setup.cfg pyproject.toml LICENSE README.md $(shell find rough sample_profiles -name '*.py' -o -name '*.tsv' -o -name '*.x3p')
 
-.PHONY: demo demo-pipeline test lint format docs wheel install-wheel bench fuzz clean
+.PHONY: demo demo-pipeline test lint format docs wheel install-wheel bench bench-run fuzz clean
 
 $(BIN)/.installed: $(SOURCES)
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -88,7 +88,14 @@ docs: $(BIN)/.installed
 	PATH="$(abspath $(BIN)):$$PATH" PYTHONSAFEPATH=1 $(BIN)/python -m sphinx -W --keep-going -q -b html docs build/docs
 	@echo "documentation: build/docs/index.html"
 
+# every benchmark, paired with its baseline; the README's table is written from their figures
 bench: $(BIN)/.installed
+	@mkdir -p build && rm -f build/bench.jsonl
+	ROUGH_BENCH_RESULTS=build/bench.jsonl $(MAKE) --no-print-directory bench-run BIN=$(BIN)
+	$(BIN)/python bench/table.py build/bench.jsonl README.md
+
+bench-run:
+	$(BIN)/python bench/bench_startup.py
 	$(BIN)/python bench/bench_io.py
 	$(BIN)/python bench/bench_metrology.py
 	$(BIN)/python bench/bench_fractal.py

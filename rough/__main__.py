@@ -1,5 +1,5 @@
 """``python -m rough`` is the ``rough`` command."""
 
-from .cli.main import main
+from .cli import main
 
 main()

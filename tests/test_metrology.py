@@ -255,6 +255,52 @@ def test_map_dropouts_give_the_parameters_of_the_valid_points():
     assert gappy["Sz"] == pytest.approx(centred.max() - centred.min(), rel=1e-12)
 
 
+@settings(max_examples=30, deadline=None)
+@given(
+    rows=st.integers(2, 11),
+    columns=st.integers(2, 11),
+    fraction=st.sampled_from([0.0, 0.3]),
+    seed=st.integers(0, 2**16),
+)
+def test_autocorrelation_is_the_mean_product_over_pairs_of_valid_points(rows, columns, fraction, seed):
+    from rough.metrology.parameters import autocorrelation
+
+    rng = np.random.default_rng(seed)
+    heights = rng.normal(size=(rows, columns))
+    heights[rng.random(heights.shape) < fraction] = np.nan
+    heights[0, 0] = 1.5  # at least one valid point
+    acf, lag_x, lag_y = autocorrelation(Surface(heights, (2e-6, 3e-6)))
+    deviation = heights - np.nanmean(heights)
+    zero = np.nanmean(deviation**2)
+    for j, ly in enumerate(np.rint(lag_y / 3e-6).astype(int)):
+        for i, lx in enumerate(np.rint(lag_x / 2e-6).astype(int)):
+            first = deviation[max(0, -ly) : rows - max(0, ly), max(0, -lx) : columns - max(0, lx)]
+            second = deviation[max(0, ly) : rows - max(0, -ly), max(0, lx) : columns - max(0, -lx)]
+            products = (first * second)[~np.isnan(first * second)]
+            expected = products.mean() / zero if products.size and zero > 0 else np.nan
+            assert acf[j, i] == pytest.approx(expected, rel=1e-9, abs=1e-12, nan_ok=True), (ly, lx)
+
+
+@pytest.mark.parametrize("slope", ["2point", "7point"])
+def test_gradients_of_a_gappy_map_with_unequal_sides(slope):
+    from rough.metrology.parameters import SEVEN_POINT
+
+    rng = np.random.default_rng(3)
+    heights = rng.normal(size=(37, 90)) * 1e-6
+    heights[rng.random(heights.shape) < 0.1] = np.nan
+    dx, dy = 1e-6, 2.5e-6
+    if slope == "2point":
+        gx = (heights[:-1, 1:] - heights[:-1, :-1]) / dx
+        gy = (heights[1:, :-1] - heights[:-1, :-1]) / dy
+    else:
+        gx = sum(w * heights[3:-3, 3 - k : heights.shape[1] - 3 - k] for k, w in zip(range(-3, 4), SEVEN_POINT)) / dx
+        gy = sum(w * heights[3 - k : heights.shape[0] - 3 - k, 3:-3] for k, w in zip(range(-3, 4), SEVEN_POINT)) / dy
+    squared = (gx**2 + gy**2)[np.isfinite(gx**2 + gy**2)]
+    values = areal_parameters(Surface(heights, (dx, dy)), slope=slope)
+    assert values["Sdq"] == pytest.approx(np.sqrt(squared.mean()), rel=1e-12)
+    assert values["Sdr"] == pytest.approx(100 * np.mean(np.sqrt(1 + squared) - 1), rel=1e-12)
+
+
 # -- texture, features, scale ----------------------------------------------------------------
 
 

@@ -150,9 +150,14 @@ def main(args=None):
 
 def _help():
     """Bare ``rough``: the overview on standard output, status 0."""
-    with click.Context(cli, info_name="rough", **cli.context_settings) as ctx:
-        click.echo(cli.get_help(ctx))
+    click.echo(overview())
     return 0
+
+
+def overview():
+    """The text of ``rough --help`` (at the terminal's width, up to 78 columns)."""
+    with click.Context(cli, info_name="rough", **cli.context_settings) as ctx:
+        return cli.get_help(ctx)
 
 
 def run(args):

@@ -495,17 +495,15 @@ def _log_map_prefactor(log_amplitude, dimensions, resolution):
 
 def _scaled(heights, rq, blocks=None, step=None):
     """``heights`` with their mean removed and scaled to RMS ``rq`` (None: as they are),
-    in place, in ``blocks`` of the first axis, calling ``step()`` after each; the two
-    means are one reduction each, bit for bit those of whole arrays."""
+    in place, in ``blocks`` of the first axis, calling ``step()`` after each. No
+    temporary array: the mean square is one dot product of the heights with themselves."""
     blocks = blocks or [slice(None)]
     if rq is not None:
         mean = heights.mean()
-        squares = np.empty_like(heights)
         for part in blocks:
             heights[part] -= mean
-            np.multiply(heights[part], heights[part], out=squares[part])
-        factor = rq / math.sqrt(np.mean(squares))
-        squares = None
+        flat = heights.reshape(-1)
+        factor = rq / math.sqrt(float(flat @ flat) / flat.size)
     for part in blocks:
         if rq is not None:
             heights[part] *= factor

@@ -259,7 +259,9 @@ def _checked(surface, format_name, options, windowed=False):
     """The checks and options every format shares: infinite heights → NaN, at least
     two points and one valid, ``options.spacing`` and ``options.window``."""
     surface.source_format = format_name
-    if not np.isfinite(surface.heights).all():
+    with np.errstate(over="ignore", invalid="ignore"):
+        finite = bool(np.isfinite(surface.heights.sum()))  # one pass, no temporary; an overflow checks in full
+    if not finite and not np.isfinite(surface.heights).all():
         infinite = np.isinf(surface.heights)
         if infinite.any():
             first = np.unravel_index(np.argmax(infinite), infinite.shape)[::-1]
@@ -271,7 +273,7 @@ def _checked(surface, format_name, options, windowed=False):
             surface.heights = np.where(infinite, np.nan, surface.heights)
     if surface.heights.size < 2:
         raise FormatError(f"holds {surface.heights.size} point; a surface needs at least two points")
-    if np.isnan(surface.heights).all():
+    if not finite and np.isnan(surface.heights).all():
         raise FormatError(f"holds no valid points (all {surface.heights.size} heights are invalid)")
     given = None if options.spacing is None else options.spacing[: surface.heights.ndim]
     if given is not None and tuple(surface.spacing) != tuple(given):

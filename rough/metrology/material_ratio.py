@@ -47,7 +47,7 @@ import math
 import numpy as np
 
 from ..errors import InputError
-from .parameters import ROUNDING, combined, map_profiles
+from .parameters import BLOCK, ROUNDING, combined, map_profiles
 
 CENTRAL_REGION = 40.0  # % of material ratio, ISO 13565-2 and ISO 25178-2
 PROBABILITY_RANGE = 3.0  # standard deviations either side of the mean, ISO 13565-3
@@ -191,13 +191,25 @@ class MaterialRatioCurve:
 
     def __init__(self, surface):
         heights = np.asarray(getattr(surface, "heights", surface), dtype=np.float64).ravel()
-        heights = heights[~np.isnan(heights)]
+        total = heights.sum()
+        if not math.isfinite(total):
+            heights = heights[~np.isnan(heights)]
+            total = heights.sum()
         if heights.size < 2:
             raise InputError("the material-ratio curve needs at least two valid points")
-        self.heights = np.sort(heights - heights.mean())[::-1]
+        ordered = total / heights.size - heights  # one new array: sorted in place, turned descending
+        ordered.sort()
+        np.negative(ordered, out=ordered)
+        ordered += 0.0  # -0.0 to 0.0
+        self.heights = ordered
         self.ratios = np.linspace(0.0, 100.0, heights.size)
-        steps = np.diff(self.ratios) * (self.heights[:-1] + self.heights[1:]) / 2
-        self._integral = np.concatenate(([0.0], np.cumsum(steps)))
+        self._integral = np.empty(heights.size)
+        self._integral[0] = 0.0
+        steps = self._integral[1:]  # the trapezia, then summed in place
+        np.add(self.heights[:-1], self.heights[1:], out=steps)
+        steps *= np.diff(self.ratios)
+        steps /= 2
+        np.cumsum(steps, out=steps)
         self._rounding = ROUNDING * float(np.max(np.abs(self.heights)))
 
     def ratio_at(self, height):
@@ -254,15 +266,22 @@ class MaterialRatioCurve:
         -------
         Core
         """
-        starts = self.ratios[self.ratios <= 100.0 - CENTRAL_REGION]
-        drops = self.heights[: starts.size] - self.height_at(starts + CENTRAL_REGION)
-        first = int(np.argmin(drops))
+        first, drop = 0, math.inf  # the first window of least drop, found a block at a time
+        windows = int(np.searchsorted(self.ratios, 100.0 - CENTRAL_REGION, side="right"))
+        for top in range(0, windows, BLOCK):
+            starts = self.ratios[top : min(top + BLOCK, windows)]
+            drops = self.heights[top : top + starts.size] - np.interp(
+                starts + CENTRAL_REGION, self.ratios, self.heights
+            )
+            least = int(np.argmin(drops))
+            if drops[least] < drop:
+                first, drop = top + least, float(drops[least])
         start = self.ratios[first]
         end = np.searchsorted(self.ratios, start + CENTRAL_REGION, side="right")
         if end - first > 1:
             slope, intercept = _line(self.ratios[first:end], self.heights[first:end])
         else:  # fewer than two points in the window (fewer than four in all): the secant
-            slope = -float(drops[first]) / CENTRAL_REGION
+            slope = -drop / CENTRAL_REGION
             intercept = float(self.heights[first]) - slope * start
         top, bottom = intercept, intercept + 100.0 * slope
         mr1, mr2 = float(self._ratio(top, "left")), float(self._ratio(bottom, "right"))
@@ -282,10 +301,15 @@ class MaterialRatioCurve:
         from scipy.special import ndtri
 
         n = self.heights.size
-        deviates = ndtri((np.arange(n) + 0.5) / n)  # ascending, as the heights reversed
-        heights = self.heights[::-1]
-        inside = np.abs(deviates) <= PROBABILITY_RANGE
-        deviates, heights = deviates[inside], heights[inside]
+        deviates = np.arange(n, dtype=np.float64)
+        deviates += 0.5
+        deviates /= n
+        ndtri(deviates, out=deviates)  # ascending, as the heights reversed
+        inside = slice(
+            np.searchsorted(deviates, -PROBABILITY_RANGE, side="left"),
+            np.searchsorted(deviates, PROBABILITY_RANGE, side="right"),
+        )
+        deviates, heights = deviates[inside], self.heights[::-1][inside]
         if deviates.size < 40:
             return ProbabilityFit(math.nan, math.nan, math.nan, math.nan, math.nan)
         return _two_lines(deviates, heights)
@@ -306,31 +330,51 @@ def _line(x, y):
 def _two_lines(q, h):
     """The continuous broken line ``h = a + v·min(q - b, 0) + p·max(q - b, 0)`` of least
     squares over the breaks ``b`` at the points' deviates (q ascending): every break
-    on a grid of at most 1024, then every break between the best one's neighbours."""
+    on a grid of at most 1024, then every break between the best one's neighbours.
+    The moments' running sums are kept only at those breaks (one moment at a time)."""
     from scipy.special import ndtr
 
     n = q.size
     least = max(2, int(LEAST_REGION * n))
-    sums = {name: np.concatenate(([0.0], np.cumsum(values))) for name, values in _moments(q, h).items()}
     stride = max(1, (n - 2 * least) // 1024)
     coarse = np.arange(least, n - least, stride)
-    residual, _ = _broken_lines(q, sums, coarse)
-    best = coarse[int(np.argmin(residual))]
-    fine = np.arange(max(least, best - stride), min(n - least, best + stride + 1))
-    residual, coefficients = _broken_lines(q, sums, fine)
+    ends = np.append(coarse, n)
+    sums = {name: np.cumsum(values)[ends - 1] for name, values in _moments(q, h)}
+    residual, _ = _broken_lines(q, sums, ends)
+    best = int(np.argmin(residual))
+    before = max(0, best - 1)  # the window starts at a coarse break, whose running sums are known
+    fine = np.arange(coarse[before], min(n - least, coarse[best] + stride + 1))
+    window = slice(fine[0], fine[-1])
+    sums = {name: _running(values, sums[name][before], sums[name][-1]) for name, values in _moments(q, h, window)}
+    residual, coefficients = _broken_lines(q, sums, np.append(fine, n))
     best = int(np.argmin(residual))
     intercept, valley, plateau = coefficients[best]
     deviate = float(q[fine[best]])
     return ProbabilityFit(float(plateau), float(valley), float(100.0 * ndtr(-deviate)), deviate, float(intercept))
 
 
-def _broken_lines(q, sums, breaks):
+def _running(values, before, total):
+    """Running sums over ``values`` continuing from ``before`` (the sum of everything
+    earlier), then the overall ``total``: the same sums, in the same order of
+    additions, as one cumulative sum over the whole."""
+    running = np.empty(values.size + 2)
+    running[0] = before
+    running[1:-1] = values
+    running[1] += before
+    np.cumsum(running[1:-1], out=running[1:-1])
+    running[-1] = total
+    return running
+
+
+def _broken_lines(q, sums, ends):
     """Residual sums of squares and coefficients (a, v, p) of the broken line at each
-    break index, from the cumulative ``sums`` of the moments."""
-    n = q.size
+    break index of ``ends[:-1]`` (``ends[-1]`` is the number of points), from the
+    moments' running sums at those indices (``sums[name][i]``: the sum over the
+    points before ``ends[i]``)."""
+    n, breaks = ends[-1], ends[:-1]
     b = q[breaks]
-    low = {name: total[breaks] for name, total in sums.items()}  # points below the break
-    high = {name: total[-1] - total[breaks] for name, total in sums.items()}
+    low = {name: total[:-1] for name, total in sums.items()}  # points below the break
+    high = {name: total[-1] - total[:-1] for name, total in sums.items()}
     count_low, count_high = breaks.astype(float), n - breaks.astype(float)
     # Normal equations in the columns 1, u = min(q - b, 0), w = max(q - b, 0).
     su, sw = low["q"] - b * count_low, high["q"] - b * count_high
@@ -351,8 +395,14 @@ def _broken_lines(q, sums, breaks):
     return sums["hh"][-1] - np.sum(coefficients * rhs, axis=-1), coefficients
 
 
-def _moments(q, h):
-    return {"q": q, "qq": q * q, "h": h, "qh": q * h, "hh": h * h}
+def _moments(q, h, window=slice(None)):
+    """``(name, values)`` of the moments q, q², h, qh, h² over ``window``, one at a time."""
+    q, h = q[window], h[window]
+    yield "q", q
+    yield "qq", q * q
+    yield "h", h
+    yield "qh", q * h
+    yield "hh", h * h
 
 
 def functional_parameters(

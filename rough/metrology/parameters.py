@@ -37,6 +37,8 @@ log = logging.getLogger("rough")
 SLOPES = ("2point", "7point")
 SEVEN_POINT = np.array([1.0, -9.0, 45.0, 0.0, -45.0, 9.0, -1.0]) / 60.0
 ROUNDING = 64 * np.finfo(float).eps  # relative: deviations this small are the rounding of the mean (measured ≤ 2.3 eps)
+BLOCK = 1 << 16  # points per block when streaming through a map: cache-sized, no full-size temporaries
+FFT_BLOCK = 1 << 20  # points per block of 1-D transforms: few calls, a few MB of scratch
 
 # key: (unit, what it is). Units: "m", "1/m", "1" (dimensionless), "%", "deg".
 PROFILE = {
@@ -70,36 +72,62 @@ AREAL = {
 }
 
 
+def centring(heights):
+    """``(mean, count, constant)`` of the valid points of ``heights``: their mean and
+    number, and whether they differ from that mean only by its rounding (a constant
+    surface, whose deviations count as exactly zero). Reads a NaN-free array without
+    copying it."""
+    flat = heights.reshape(-1)
+    total = flat.sum()
+    if math.isfinite(total):
+        count = flat.size
+    else:
+        valid = flat[~np.isnan(flat)]
+        total, count = valid.sum(), valid.size
+    if not count:
+        return math.nan, 0, False
+    mean = total / count
+    return mean, count, max(np.nanmax(flat) - mean, mean - np.nanmin(flat)) <= ROUNDING * abs(mean)
+
+
 def centred(heights):
     """``heights`` less the mean of their valid points (NaN stays NaN); exactly zero
     where they differ from that mean only by its rounding (a constant surface)."""
-    valid = heights[~np.isnan(heights)]
-    if not valid.size:
+    mean, count, constant = centring(heights)
+    if not count:
         return heights
-    mean = valid.mean()
-    deviation = heights - mean
-    if np.nanmax(np.abs(deviation)) <= ROUNDING * abs(mean):
+    if constant:
         return np.where(np.isnan(heights), np.nan, 0.0)
-    return deviation
+    return heights - mean
 
 
-def amplitude(values):
-    """Mean-removed moments of a 1-D array of valid heights: Ra, Rq, Rsk, Rku (NaN for a
-    constant surface), and the height range (max, min) about the mean."""
-    if values.size == 0:
+def amplitude(heights):
+    """Mean-removed moments of the valid points of ``heights`` (any shape; NaN points
+    left out): Ra, Rq, Rsk, Rku (NaN for a constant surface), and the height range
+    (max, min) about the mean. Streams through the points a block at a time, with no
+    full-size temporaries."""
+    mean, count, constant = centring(heights)
+    if count == 0:
         raise InputError("no valid points: nothing to evaluate")
-    centred_values = centred(values)
-    squared = centred_values * centred_values
-    rq = math.sqrt(squared.mean())
-    skew = float(np.mean(squared * centred_values)) / rq**3 if rq > 0 else math.nan
-    kurtosis = float(np.mean(squared * squared)) / rq**4 if rq > 0 else math.nan
+    if constant:
+        return {"a": 0.0, "q": 0.0, "sk": math.nan, "ku": math.nan, "p": 0.0, "v": 0.0}
+    flat = heights.reshape(-1)
+    sums = []
+    for start in range(0, flat.size, BLOCK):
+        deviation = flat[start : start + BLOCK] - mean
+        if count < flat.size:
+            deviation = deviation[~np.isnan(deviation)]
+        squared = deviation * deviation
+        sums.append((np.abs(deviation).sum(), squared.sum(), (squared * deviation).sum(), (squared * squared).sum()))
+    absolute, square, cube, fourth = (math.fsum(column) / count for column in zip(*sums))
+    rq = math.sqrt(square)
     return {
-        "a": float(np.abs(centred_values).mean()),
+        "a": absolute,
         "q": rq,
-        "sk": skew,
-        "ku": kurtosis,
-        "p": float(centred_values.max()),
-        "v": 0.0 - float(centred_values.min()),
+        "sk": cube / rq**3 if rq > 0 else math.nan,
+        "ku": fourth / rq**4 if rq > 0 else math.nan,
+        "p": float(np.nanmax(flat) - mean),
+        "v": 0.0 - float(np.nanmin(flat) - mean),
     }
 
 
@@ -195,9 +223,8 @@ def profile_parameters(surface, sampling_lengths=5, slope="2point", jrc_spacing=
     """
     z = surface.heights
     dx = surface.spacing[0]
-    valid = ~np.isnan(z)
     levels = centred(z)
-    moments = amplitude(z[valid])
+    moments = amplitude(z)
     rp, rv = _per_sampling_length(levels, sampling_lengths)
     rz = rp + rv
     length = z.size * dx
@@ -293,14 +320,8 @@ def areal_parameters(surface, slope="2point", threshold=0.2):
     >>> print(f"Sq {values['Sq'] * 1e6:.1f} µm, Sal {values['Sal'] * 1e3:.2f} mm, Str {values['Str']:.2f}")
     Sq 100.0 µm, Sal 0.86 mm, Str 0.73
     """
-    z = surface.heights
-    dx, dy = surface.spacing
-    valid = ~np.isnan(z)
-    moments = amplitude(z[valid])
-    gx, gy = slopes(z, dx, slope, axis=1), slopes(z, dy, slope, axis=0)
-    if slope == "2point":
-        gx, gy = gx[:-1, :], gy[:, :-1]
-    squared = gx**2 + gy**2
+    moments = amplitude(surface.heights)
+    sdq, sdr = gradient_means(surface, slope)
     sal, str_ratio = autocorrelation_lengths(surface, threshold)
     return {
         "Sa": moments["a"],
@@ -310,12 +331,40 @@ def areal_parameters(surface, slope="2point", threshold=0.2):
         "Sp": moments["p"],
         "Sv": moments["v"],
         "Sz": moments["p"] + moments["v"],
-        "Sdq": float(math.sqrt(np.nanmean(squared))) if np.isfinite(squared).any() else math.nan,
-        "Sdr": float(100.0 * np.nanmean(np.sqrt(1.0 + squared) - 1.0)) if np.isfinite(squared).any() else math.nan,
+        "Sdq": sdq,
+        "Sdr": sdr,
         "Sal": sal,
         "Str": str_ratio,
         "Std": texture_direction(surface),
     }
+
+
+def gradient_means(surface, slope="2point"):
+    """Sdq and Sdr (%) of a map: the RMS of |∇z| and the mean of √(1 + |∇z|²) - 1 over
+    the points where both slopes are valid (forward differences from the point, or
+    ISO 4287's seven-point derivative on interior points); NaN where there are none.
+    Works a block of rows at a time."""
+    z = surface.heights
+    dx, dy = surface.spacing
+    if slope not in SLOPES:
+        raise InputError(f"slope method must be one of {', '.join(SLOPES)}, not {slope!r}")
+    halo = 0 if slope == "2point" else 3
+    if slope == "7point" and min(z.shape) < 7:
+        raise InputError("the seven-point slope needs at least 7 points along each axis")
+    sums, count = [], 0
+    rows_per_block = max(1, BLOCK // z.shape[1])
+    for top in range(halo, z.shape[0] - max(halo, 1), rows_per_block):
+        bottom = min(top + rows_per_block, z.shape[0] - max(halo, 1))
+        gx = slopes(z[top:bottom], dx, slope, axis=1)
+        gy = slopes(z[top - halo : bottom + max(halo, 1)], dy, slope, axis=0)
+        squared = gx**2 + gy[:, :-1] ** 2 if slope == "2point" else gx**2 + gy[:, 3:-3] ** 2
+        squared = squared[~np.isnan(squared)]
+        sums.append((squared.sum(), (np.sqrt(1.0 + squared) - 1.0).sum()))
+        count += squared.size
+    if not count:
+        return math.nan, math.nan
+    square, developed = (math.fsum(column) / count for column in zip(*sums))
+    return math.sqrt(square), 100.0 * developed
 
 
 def map_profiles(surface, along):
@@ -457,35 +506,72 @@ def _z2(surface, jrc_spacing):
 def autocorrelation(surface):
     """The normalised autocorrelation of the mean-removed valid heights, over pairs
     of valid points only, on lags up to half the map in each direction: returns
-    ``(acf, lag_x, lag_y)`` with ``acf[j, i]`` at lag ``(lag_x[i], lag_y[j])``."""
-    from scipy import fft
+    ``(acf, lag_x, lag_y)`` with ``acf[j, i]`` at lag ``(lag_x[i], lag_y[j])``.
 
+    Computed through zero-padded FFTs a block at a time, only the lags needed (one
+    half plane; the other is its mirror image), so that it never holds more than
+    about 2.7 times the map's size."""
     z = surface.heights
-    valid = ~np.isnan(z)
     ny, nx = z.shape
-    shape = (fft.next_fast_len(ny + ny // 2 + 1, real=True), fft.next_fast_len(nx + nx // 2 + 1, real=True))
-    spectrum = fft.rfft2(np.where(valid, centred(z), 0.0), shape, workers=-1)
-    products = fft.irfft2(spectrum * spectrum.conj(), shape, workers=-1)
-    del spectrum
-    if valid.all():
-        pairs = np.outer(_overlap(ny, shape[0]), _overlap(nx, shape[1]))
-    else:
-        mask = fft.rfft2(valid.astype(np.float64), shape, workers=-1)
-        pairs = np.rint(fft.irfft2(mask * mask.conj(), shape, workers=-1))
     hy, hx = ny // 2, nx // 2
-    rows = np.r_[shape[0] - hy : shape[0], 0 : hy + 1]
-    columns = np.r_[shape[1] - hx : shape[1], 0 : hx + 1]
+    mean, count, constant = centring(z)
+    products = _half_correlation(lambda rows: _deviation(z[rows], mean, constant), z.shape)
+    if count == z.size:
+        pairs = np.outer(ny - np.arange(hy + 1.0), nx - np.abs(np.arange(-hx, hx + 1.0)))
+    else:
+        pairs = np.rint(_half_correlation(lambda rows: (~np.isnan(z[rows])).astype(np.float64), z.shape))
+    acf = np.empty((2 * hy + 1, 2 * hx + 1))
     with np.errstate(invalid="ignore", divide="ignore"):
-        acf = products[np.ix_(rows, columns)] / pairs[np.ix_(rows, columns)]
-        acf = acf / acf[hy, hx]
+        np.divide(products, pairs, out=acf[hy:])
+        acf[hy:][pairs == 0] = np.nan  # no pair of valid points at this lag (not the rounding of the FFTs)
+        acf[hy:] /= acf[hy, hx]
+    acf[:hy] = acf[:hy:-1, ::-1]  # the autocorrelation of a real field: acf(-l) = acf(l)
     return acf, np.arange(-hx, hx + 1) * surface.spacing[0], np.arange(-hy, hy + 1) * surface.spacing[1]
 
 
-def _overlap(n, padded):
-    """How many pairs of points of a full row of ``n`` lie at each circular lag."""
-    lags = np.arange(padded)
-    lags = np.where(lags <= padded // 2, lags, padded - lags)
-    return np.clip(n - lags, 0, None).astype(np.float64)
+def _deviation(heights, mean, constant):
+    """A block of heights less their mean, zero at invalid points (and everywhere on a
+    constant surface)."""
+    if constant:
+        return np.zeros_like(heights)
+    return np.where(np.isnan(heights), 0.0, heights - mean)
+
+
+def _half_correlation(field, shape):
+    """The circular autocorrelation of a map (``field(rows)`` gives a block of its rows)
+    zero-padded to ``1.5 ×`` its shape (so that no lag up to half the map wraps round),
+    at lags 0 … ny//2 along y and -nx//2 … nx//2 along x. Row transforms, column
+    transforms and the inverse are taken a block at a time, the inverse only over the
+    lags kept, so that the padded spectrum is never whole in memory."""
+    from scipy import fft
+
+    ny, nx = shape
+    py = fft.next_fast_len(ny + ny // 2 + 1, real=True)
+    px = fft.next_fast_len(nx + nx // 2 + 1, real=True)
+    width, hy, hx = px // 2 + 1, ny // 2, nx // 2
+    rows_per_block, columns_per_block = max(1, FFT_BLOCK // px), max(1, FFT_BLOCK // py)
+    along_x = np.empty((ny, width), dtype=complex)
+    padded = np.zeros((min(rows_per_block, ny), px))
+    for top in range(0, ny, rows_per_block):
+        rows = slice(top, top + rows_per_block)
+        block = padded[: min(ny, top + rows_per_block) - top]
+        block[:, :nx] = field(rows)
+        along_x[rows] = fft.rfft(block, axis=1, workers=-1)
+    del padded
+    padded = np.zeros((py, min(columns_per_block, width)), dtype=complex)
+    lagged = np.empty((hy + 1, width), dtype=complex)
+    for left in range(0, width, columns_per_block):
+        columns = slice(left, left + columns_per_block)
+        block = padded[:, : min(width, left + columns_per_block) - left]
+        block[:ny] = along_x[:, columns]
+        block[ny:] = 0
+        parts = fft.fft(block, axis=0, workers=-1, overwrite_x=True).view(np.float64)
+        np.square(parts, out=parts)
+        lagged[:, columns] = fft.rfft(parts[:, 0::2] + parts[:, 1::2], axis=0, workers=-1)[: hy + 1]
+    del along_x, padded, parts
+    # the power is real: its inverse transform along y is the conjugate of the forward one
+    correlation = fft.irfft(np.conj(lagged, out=lagged), n=px, axis=1, workers=-1) / py
+    return np.concatenate([correlation[:, px - hx :], correlation[:, : hx + 1]], axis=1)
 
 
 def autocorrelation_lengths(surface, threshold=0.2, directions=360):
@@ -494,22 +580,20 @@ def autocorrelation_lengths(surface, threshold=0.2, directions=360):
     along each axis; Str is NaN when the ACF does not fall to ``threshold`` within
     that in some direction (the texture is longer than half the map); both are NaN
     for a constant surface."""
-    from scipy.ndimage import map_coordinates
-
     acf, lag_x, lag_y = autocorrelation(surface)
     dx, dy = surface.spacing
-    cy, cx = (acf.shape[0] - 1) / 2, (acf.shape[1] - 1) / 2
+    centre = ((acf.shape[0] - 1) / 2, (acf.shape[1] - 1) / 2)
     finest = min(dx, dy) / 4
-    decay, reaches = np.full(directions, np.nan), np.empty(directions)
+    decay, reaches, rays = np.full(directions, np.nan), np.empty(directions), []
     for k, angle in enumerate(np.linspace(0, np.pi, directions, endpoint=False)):
         reach = reaches[k] = min(lag_x[-1] / max(abs(math.cos(angle)), 1e-12), lag_y[-1] / max(math.sin(angle), 1e-12))
         step = max(finest, reach / (4 * max(acf.shape)))  # at most 4 samples a lag when dx and dy differ wildly
         radii = np.arange(0, reach + step / 2, step)
-        along = map_coordinates(acf, [cy + radii * math.sin(angle) / dy, cx + radii * math.cos(angle) / dx], order=1)
-        below = np.flatnonzero(along <= threshold)
-        if below.size:
-            i = below[0]
-            decay[k] = radii[i - 1] + (along[i - 1] - threshold) / (along[i - 1] - along[i]) * step
+        rays.append((radii, step, [centre[0] + radii * math.sin(angle) / dy, centre[1] + radii * math.cos(angle) / dx]))
+    for k, along in _first_falls(acf, rays, threshold):
+        radii, step, _ = rays[k]
+        i = np.flatnonzero(along <= threshold)[0]
+        decay[k] = radii[i - 1] + (along[i - 1] - threshold) / (along[i - 1] - along[i]) * step
     fastest = float(np.nanmin(decay)) if np.isfinite(decay).any() else math.nan
     slowest = float(np.max(decay)) if np.isfinite(decay).all() else math.nan
     if np.isnan(slowest) and np.isfinite(fastest):
@@ -522,6 +606,32 @@ def autocorrelation_lengths(surface, threshold=0.2, directions=360):
     return fastest, fastest / slowest if slowest > 0 else math.nan
 
 
+def _first_falls(acf, rays, threshold, first=64):
+    """``(k, values)`` for each ray ``k`` (radii, step, grid coordinates) along which the
+    ACF falls to ``threshold``: its bilinear values from the centre to the first
+    point at or below it. All rays are interpolated in one call per round, a stretch
+    at a time (doubling), so that a short decay costs little."""
+    from scipy.ndimage import map_coordinates
+
+    done, seen, length = {k: 0 for k in range(len(rays))}, {k: [] for k in range(len(rays))}, first
+    while done:
+        pieces = {k: (start, min(start + length, rays[k][0].size)) for k, start in done.items()}
+        coordinates = np.concatenate(
+            [np.array([axis[a:b] for axis in rays[k][2]]) for k, (a, b) in pieces.items()], axis=1
+        )
+        values = np.split(map_coordinates(acf, coordinates, order=1), np.cumsum([b - a for a, b in pieces.values()]))
+        for (k, (a, b)), piece in zip(pieces.items(), values):
+            seen[k].append(piece)
+            if (piece <= threshold).any():
+                yield k, np.concatenate(seen.pop(k))
+                del done[k]
+            elif b == rays[k][0].size:
+                del done[k], seen[k]
+            else:
+                done[k] = b
+        length *= 2
+
+
 def angular_spectrum(surface, directions=360):
     """The angular power spectrum of the mean-removed map (Hann-windowed, NaN points
     set to the mean): ``(wavevector angles in degrees, power)``, integrating
@@ -531,23 +641,33 @@ def angular_spectrum(surface, directions=360):
     from scipy.ndimage import map_coordinates
 
     z = surface.heights
-    valid = ~np.isnan(z)
-    window = np.outer(np.hanning(z.shape[0]), np.hanning(z.shape[1]))
-    transform = fft.rfft2(np.where(valid, centred(z), 0.0) * window, workers=-1)
-    power = fft.fftshift(transform.real**2 + transform.imag**2, axes=0)
     ny, nx = z.shape
+    mean, _, constant = centring(z)
+    window_y, window_x = np.hanning(ny), np.hanning(nx)
+    field = np.empty((ny, nx))
+    rows_per_block = max(1, BLOCK // nx)
+    for top in range(0, ny, rows_per_block):
+        rows = slice(top, top + rows_per_block)
+        field[rows] = _deviation(z[rows], mean, constant) * np.outer(window_y[rows], window_x)
+    transform = fft.rfft2(field, workers=-1)
+    del field
+    power = np.empty(transform.shape)  # |F|², shifted along y so that fy = 0 is row ny // 2
+    shift = ny // 2
+    for target, source in ((slice(shift, ny), slice(0, ny - shift)), (slice(0, shift), slice(ny - shift, ny))):
+        power[target] = transform[source].real ** 2 + transform[source].imag ** 2
+    del transform
     dfx, dfy = 1 / (nx * surface.spacing[0]), 1 / (ny * surface.spacing[1])
     nyquist = min(0.5 / surface.spacing[0], 0.5 / surface.spacing[1])
     step = min(dfx, dfy)
     radii = np.arange(2 * step, nyquist, step)
     angles = np.linspace(0, 180, directions, endpoint=False)
-    spectrum = np.empty(directions)
+    coordinates = np.empty((2, directions, radii.size))
     for k, angle in enumerate(np.radians(angles)):
         fx, fy = radii * math.cos(angle), radii * math.sin(angle)
         flip = np.where(fx < 0, -1.0, 1.0)  # |F(-f)| = |F(f)|: fold onto the kx ≥ 0 half plane
-        coordinates = [ny // 2 + flip * fy / dfy, flip * fx / dfx]
-        spectrum[k] = map_coordinates(power, coordinates, order=1).sum() * step
-    return angles, spectrum
+        coordinates[:, k] = [ny // 2 + flip * fy / dfy, flip * fx / dfx]
+    along = map_coordinates(power, coordinates.reshape(2, -1), order=1).reshape(directions, radii.size)
+    return angles, along.sum(axis=1) * step
 
 
 def texture_direction(surface):

@@ -12,18 +12,37 @@ surface above its apex at the lateral offset o (a disk for profiles, a ball for 
   tip cannot tell from the measured one, the best estimate of the material surface
   from a traced one. It never lies below the surface and is idempotent.
 
-Both are exact on the sample grid (every offset within r, unequal x and y spacing
-handled through physical distances), computed by brute force in compiled code:
-scikit-image's rolling-ball kernel (a profile is a map of one row), in tiles of about
-0.1 s shared by all cores, so that Ctrl-C stops a pass within a tile. The cost
-is one comparison per point and tip offset, so it grows as (r/Δx)² for maps; an exact
-envelope sweep (O(N·r/Δx)) would need compiled code of our own and would not beat the
-vectorised brute force at tips of ~100 samples.
+Both are exact on the sample grid: every offset within r counts (those on the rim
+too, whatever the rounding), unequal x and y spacing handled through physical
+distances. The ball is taken a row of offsets at a time: the offsets k rows above
+and k rows below a point form the same semicircle, of radius √(r² - (kΔy)²), along
+x, so the dilation is the maximum over k = 0 … R (R = r/Δy; a profile is a map of
+one row) of one 1-D dilation by that semicircle of the pointwise maximum of the rows
+k above and k below. Each 1-D dilation is done in compiled code (numba), in the
+quicker of two ways for its width w (in samples):
+
+* directly, over the offsets 0, ±1 … ±w, vectorised: about w/6 ns per point, the
+  way for rows up to about 220 samples wide;
+* by a sweep along the row keeping the upper envelope of the semicircles of radius
+  √(r² - (kΔy)²) about every point (equal semicircles cross at most once, so a stack
+  holds it, as in Felzenszwalb and Huttenlocher's distance transform): about 35 ns
+  per point whatever the width. Where two semicircles cross is estimated in closed
+  form, then settled by comparing the very sums the direct way compares.
+
+Each result is the sum ``z(p + o) - s(o)`` of one offset of the tip, the greatest:
+the direct way gives brute force's value to the last bit, and so does the sweep,
+but where two offsets' sums tie within a rounding error (it may then settle on
+either). A map of N points costs about N · Σ_k min(w_k / 6, 35) ns on one core,
+growing as (r/Δx)² for small tips and as r/Δx for big ones (a 0.5 mm ball at 0.01
+mm spacing: 0.3 µs per point). The rows (long ones cut into tiles) are handed out in
+chunks of about 0.1 s of work to one thread per core, so that Ctrl-C stops a pass
+within a chunk.
 
 Invalid points (NaN) never touch the tip; results are NaN where the input is.
 Beyond the ends there is no surface: a tip over an end rests on the points inside.
 """
 
+import functools
 import logging
 import math
 import os
@@ -35,10 +54,12 @@ from ..errors import InputError
 log = logging.getLogger("rough")
 
 PRESETS = {"needle": 0.05e-3, "fingernail": 0.5e-3, "fingertip": 8e-3}
-SECONDS_PER_COMPARISON = 1e-9  # on one core, measured on the 2-core build machine (estimates only)
+# Estimates only, on one core of the 2-core build machine (bench/bench_tip.py):
+SECONDS_PER_PAIR = 0.17e-9  # one point and one pair of offsets ±x of a row of the tip, the direct way
+SECONDS_PER_SWEEP = 37e-9  # one point and one row of the tip, swept
 MAX_SECONDS = 3600  # a pass estimated longer is refused
 MAX_SECONDS_WIDER = 60  # ... and with a tip wider than the scan (see _check_cost)
-CHUNK_SECONDS = 0.1  # the work of one tile: Ctrl-C waits for at most one tile per thread
+CHUNK_SECONDS = 0.1  # the work of one chunk: Ctrl-C waits for at most one chunk per thread
 
 
 def tip_profile(radius, spacing, shape=None):
@@ -50,8 +71,7 @@ def tip_profile(radius, spacing, shape=None):
         raise InputError(f"the tip radius must be positive, not {radius} m")
     axes = [np.arange(-reach, reach + 1) * d for reach, d in zip(_reach(radius, spacing, shape), spacing)]
     squared = axes[0] ** 2 if len(axes) == 1 else axes[1][:, None] ** 2 + axes[0][None, :] ** 2
-    inside = squared <= radius * radius * (1 + 1e-12)  # offsets on the rim count, whatever the rounding
-    return np.where(inside, np.sqrt(np.maximum(radius * radius - squared, 0.0)), -np.inf)
+    return _tip_heights(radius, squared)
 
 
 def traced(surface, radius):
@@ -90,7 +110,12 @@ def traced(surface, radius):
     Notes
     -----
     Exact on the sample grid (unequal x and y spacing handled through physical
-    distances), by brute force: the cost grows as (r/Δx)² per point for maps.
+    distances): every offset within r counts. The ball is taken a row of offsets at
+    a time, each row by the quicker of a direct maximum over its offsets and a sweep
+    along the surface's rows keeping the upper envelope of semicircles (see the
+    module's description), so the cost per point grows as (r/Δx)² for small tips
+    and as r/Δx for big ones. The first call in a process compiles the loops with
+    numba (a few seconds, then cached on disk where a cache directory is writable).
     Beyond the ends there is no surface: a tip over an end rests on the points
     inside.
 
@@ -145,6 +170,11 @@ def closing_envelope(surface, radius):
     --------
     traced : The path of the apex (the dilation alone).
 
+    Notes
+    -----
+    Two passes, each exact on the sample grid and of the cost of :func:`traced`: the
+    dilation, then the erosion, done as the dilation of the negated path.
+
     Examples
     --------
     A 0.5 mm disk cannot enter a pit 30 µm wide and 50 µm deep: resting on its rims,
@@ -179,92 +209,99 @@ def closing_envelope(surface, radius):
 
 
 def _reach(radius, spacing, shape):
-    """Half-width of the tip in samples along x (and y), at most one less than the data's length."""
-    reach = [math.floor(radius / d) for d in spacing]
+    """Half-width of the tip in samples along x (and y), at most one less than the data's length;
+    with the offsets on the rim, whatever the rounding of r/Δ (0.3 mm / 0.1 mm = 2.9999999999999996)."""
+    reach = [math.floor(radius * (1 + 1e-12) / d) for d in spacing]
     if shape is not None:
         reach = [min(r, n - 1) for r, n in zip(reach, reversed(shape))]
     return reach
 
 
-def _lowering(radius, spacing, shape):
-    """``-s(o)``: 0 at the apex, -inf outside the tip."""
-    kernel = tip_profile(radius, spacing, shape)
-    return kernel - kernel[tuple(n // 2 for n in kernel.shape)]
+def _tip_heights(radius, squared):
+    """``√(r² - |o|²)`` for the squared offsets ``|o|²``, -inf outside the tip."""
+    inside = squared <= radius * radius * (1 + 1e-12)  # offsets on the rim count, whatever the rounding
+    return np.where(inside, np.sqrt(np.maximum(radius * radius - squared, 0.0)), -np.inf)
+
+
+def _quadrant(radius, spacing, shape):
+    """``-s(o)`` at the offsets ``(x Δx, k Δy)``, k and x >= 0, as ``quadrant[k, x]`` (one
+    row for a profile): the tip is symmetric about both axes. The very values of
+    :func:`tip_profile` less its apex; 0 at the apex, -inf outside the tip."""
+    reach = _reach(radius, spacing, shape)
+    x = np.arange(reach[0] + 1) * spacing[0]
+    y = np.arange(reach[1] + 1) * spacing[1] if len(spacing) == 2 else np.zeros(1)
+    heights = _tip_heights(radius, y[:, None] ** 2 + x[None, :] ** 2)
+    return heights - heights[0, 0]
 
 
 def _dilate(heights, radius, spacing, passes=1):
     """max_o [z(p + o) - s(o)] with NaN ignored; NaN where the input is NaN."""
     _check_cost(heights, radius, spacing, passes)
-    lowering = _lowering(radius, spacing, heights.shape)
     invalid = np.isnan(heights)
-    surface = np.where(invalid, -np.inf, heights)
-    if heights.ndim == 1:  # a one-row map; 0 - x, never -0: as scipy's grey_dilation, bit for bit
-        path = 0.0 - _rolling_ball(-surface[np.newaxis], lowering[np.newaxis], "tip")[0]
-    else:
-        path = -_rolling_ball(-surface, lowering, "tip")
+    path = _max_plus(np.where(invalid, -np.inf, heights), radius, spacing, "tip")
     return np.where(invalid | ~np.isfinite(path), np.nan, np.fmax(path, heights))
 
 
 def _erode(path, radius, spacing):
-    """min_o [T(p + o) + s(o)] over the finite points of the traced path ``T``."""
-    lowering = _lowering(radius, spacing, path.shape)
-    known = np.where(np.isnan(path), np.inf, path)
-    if path.ndim == 1:
-        return _rolling_ball(known[np.newaxis], lowering[np.newaxis], "envelope")[0]
-    return _rolling_ball(known, lowering, "envelope")
+    """min_o [T(p + o) + s(o)] over the finite points of the traced path ``T``: the
+    dilation of -T, negated (as 0 - x, so that a zero is +0, as the sums' minimum is)."""
+    return 0.0 - _max_plus(np.where(np.isnan(path), -np.inf, -path), radius, spacing, "envelope")
 
 
-def _rolling_ball(image, lowering, label="tip"):
-    """min_o [image(p + o) + s(o)] (scikit-image's exact rolling-ball kernel); +inf in
-    ``image`` never limits, and offsets outside the tip are left out.
+def _max_plus(image, radius, spacing, label="tip"):
+    """``max_o [image(p + o) - s(o)]`` over the tip's offsets; -inf in ``image`` never
+    wins, and there is nothing beyond the ends.
 
-    The map is cut into tiles of about CHUNK_SECONDS of work, shared by one thread per
-    core (the kernel releases the GIL); the main thread waits with a timeout, so that
-    Ctrl-C stops the workers after their current tile and cancels the rest. Every
-    point's result is what one call over the whole map gives, bit for bit: the same
-    sums compared in the same order."""
+    The rows are cut into tasks (a row, or a tile of a long row), and the tasks into
+    chunks of about CHUNK_SECONDS of work, shared by one thread per core (the compiled
+    loop releases the GIL); the main thread waits with a timeout, so that Ctrl-C stops
+    the workers after their current chunk and cancels the rest. A point's result does
+    not depend on how the work is cut."""
     import threading
     from concurrent.futures import FIRST_EXCEPTION, ThreadPoolExecutor, wait
 
     from ..progress import progress
 
-    kernel = np.where(np.isfinite(lowering), lowering, np.inf)
-    difference = kernel[tuple(n // 2 for n in kernel.shape)] - kernel  # as scikit-image's rolling_ball
-    difference[kernel == np.inf] = np.inf
-    (halo_y, halo_x), (rows, columns) = (n // 2 for n in kernel.shape), image.shape
-    padded = np.full((rows + 2 * halo_y, columns + 2 * halo_x), np.inf)
-    padded[halo_y : halo_y + rows, halo_x : halo_x + columns] = image
-    compute = _tile_kernel(padded, kernel, difference)
-    tiles = _tiles(rows, columns, kernel.size, whole_rows=compute is None, least_rows=2 * halo_y + 1)
-    threads = min(_cores(), len(tiles))
-    kernel_size = " × ".join(str(n) for n in reversed(kernel.shape)) if rows > 1 else str(kernel.shape[1])
-    extent = f"{columns} × {rows}" if rows > 1 else str(columns)
-    shared = f"{_count(len(tiles), 'tile')} on {_count(threads, 'thread')}"
-    log.info(f"{label}: a kernel of {kernel_size} samples over {extent} points, {shared}")
-    result = np.empty_like(image)
-    stop, lock, queue, finished = threading.Event(), threading.Lock(), list(reversed(tiles)), [0]
+    quadrant = _quadrant(radius, spacing, image.shape)
+    widths = np.isfinite(quadrant).sum(axis=1) - 1  # row k of the tip spans the offsets -w … w along x
+    swept = _swept(widths)
+    squared_radii = radius * radius - (np.arange(len(widths)) * spacing[-1]) ** 2  # of each row's semicircle
+    rows = np.ascontiguousarray(image.reshape(-1, image.shape[-1]))  # a profile is a map of one row
+    count, columns = rows.shape
+    tiles = max(1, columns // max(2048, 16 * quadrant.shape[1]))  # the margins of a tile cost little
+    tasks = count * tiles
+    per_task = _seconds_per_point(widths) * columns / tiles
+    chunk = max(1, min(round(CHUNK_SECONDS / per_task), math.ceil(tasks / _cores())))  # every core gets some
+    queue = [(first, min(tasks, first + chunk)) for first in reversed(range(0, tasks, chunk))]
+    threads = min(_cores(), len(queue))
+    kernel, result = _kernel(), np.empty_like(rows)
+    # compiled (or loaded from numba's cache) here, in the main thread, where Ctrl-C can stop it
+    kernel(rows, quadrant, widths, swept, squared_radii, spacing[0], tiles, 0, 0, result)
+    across = [2 * n - 1 for n in reversed(quadrant.shape)]  # x first
+    kernel_size = f"{across[0]} × {across[1]}" if count > 1 else str(across[0])
+    extent = f"{columns} × {count}" if count > 1 else str(columns)
+    shared = f"{_count(len(queue), 'chunk')} on {_count(threads, 'thread')}"
+    rows_swept = f" ({_count(int(swept.sum()), 'row')} of it swept)" if swept.any() else ""
+    log.info(f"{label}: a kernel of {kernel_size} samples{rows_swept} over {extent} points, {shared}")
+    stop, lock, finished = threading.Event(), threading.Lock(), [0]
+
+    def start(task):  # the index of the task's first point
+        return task // tiles * columns + task % tiles * columns // tiles
 
     def work():
         while not stop.is_set():
             with lock:
                 if not queue:
                     return
-                top, bottom, left, right = queue.pop()
-            if compute is None:
-                block = padded[top : bottom + 2 * halo_y, left : right + 2 * halo_x]
-                piece = _public_rolling_ball(block, kernel)[
-                    halo_y : halo_y + bottom - top, halo_x : halo_x + right - left
-                ]
-            else:
-                piece = compute(top, bottom, left, right)
-            result[top:bottom, left:right] = piece
+                first, last = queue.pop()
+            kernel(rows, quadrant, widths, swept, squared_radii, spacing[0], tiles, first, last, result)
             with lock:
-                finished[0] += piece.size
+                finished[0] += start(last) - start(first)
 
     pool = ThreadPoolExecutor(threads)
     try:
         workers = [pool.submit(work) for _ in range(threads)]
-        with progress(total=image.size, description=label, unit="point") as bar:
+        with progress(total=rows.size, description=label, unit="point") as bar:
             pending = workers
             while pending:
                 done, pending = wait(pending, timeout=0.1, return_when=FIRST_EXCEPTION)
@@ -272,51 +309,183 @@ def _rolling_ball(image, lowering, label="tip"):
                     worker.result()  # a worker's exception, here
                 bar.update(finished[0] - bar.n)
     finally:
-        stop.set()  # Ctrl-C or a failure: the workers end after their current tile
+        stop.set()  # Ctrl-C or a failure: the workers end after their current chunk
         pool.shutdown(wait=False, cancel_futures=True)
-    return result
+    return result.reshape(image.shape)
 
 
-def _tile_kernel(padded, kernel, difference):
-    """A function computing one tile from the padded image with scikit-image's
-    compiled rolling-ball loop on one core, reading the tile's window of ``padded`` in
-    place; None when this scikit-image does not have it where expected."""
+def _swept(widths):
+    """Which rows of the tip are swept rather than maximised over directly: those for
+    which the sweep is estimated quicker."""
+    return (widths + 1) * SECONDS_PER_PAIR > SECONDS_PER_SWEEP
+
+
+def _seconds_per_point(widths):
+    """The estimated work per point, on one core, for the tip's rows of these widths:
+    for each row, building the maximum of the two rows of the surface and then the
+    quicker of the two ways."""
+    widths = np.asarray(widths)[np.asarray(widths) >= 0]
+    return float(np.sum(SECONDS_PER_PAIR + np.minimum((widths + 1) * SECONDS_PER_PAIR, SECONDS_PER_SWEEP)))
+
+
+@functools.cache
+def _kernel():
+    """:func:`_rows` compiled by numba, imported here only (``rough`` starts without it).
+    Compiled once per process, or loaded from numba's cache on disk when it finds a
+    writable place for one (beside this file or in the user's cache directory)."""
+    import numba
+
     try:
-        from skimage.restoration._rolling_ball_cy import apply_kernel
-    except ImportError:
-        return None
-    flat, width, differences = padded.reshape(-1), padded.shape[1], difference.reshape(-1)
-    shape = np.array(kernel.shape, dtype=np.intp)
-
-    def compute(top, bottom, left, right):
-        piece = np.zeros((bottom - top, right - left))
-        window = np.array([bottom - top + kernel.shape[0] - 1, width], dtype=np.intp)
-        # positional: the last argument was num_threads before scikit-image 0.26, workers since
-        corner = flat[top * width + left :]
-        apply_kernel(corner, differences, piece.reshape(-1), np.array(piece.shape, dtype=np.intp), window, shape, 1)
-        return piece
-
-    return compute
+        return numba.njit(nogil=True, cache=True, error_model="numpy")(_rows)
+    except RuntimeError:  # no writable cache directory: compile in every process
+        return numba.njit(nogil=True, error_model="numpy")(_rows)
 
 
-def _public_rolling_ball(block, kernel):
-    from skimage.restoration import rolling_ball
+def _rows(image, quadrant, widths, swept, squared_radii, dx, tiles, first, last, out):
+    """Tasks ``first`` … ``last - 1`` of the dilation, task i being the tile
+    ``i % tiles`` (of ``tiles`` equal ones) of the row ``i // tiles``::
 
-    return rolling_ball(block, kernel=kernel)
+        out[y, c] = max over k and |x| <= widths[k] of
+                    max(image[y - k, c + x], image[y + k, c + x]) + quadrant[k, |x|]
 
-
-def _tiles(rows, columns, kernel_points, whole_rows=False, least_rows=1):
-    """(top, bottom, left, right) tiles of about CHUNK_SECONDS of work on one core:
-    bands of whole rows, or pieces of single rows when one row is more than that.
-    ``whole_rows``: bands only, of at least ``least_rows`` (for the public
-    rolling_ball, which also computes a tile's margins)."""
-    points = max(1, int(CHUNK_SECONDS / (kernel_points * SECONDS_PER_COMPARISON)))
-    if points >= columns or whole_rows:
-        height = min(rows, max(least_rows if whole_rows else 1, points // columns, 1))
-        return [(top, min(rows, top + height), 0, columns) for top in range(0, rows, height)]
-    pieces = math.ceil(columns / points)
-    edges = np.linspace(0, columns, pieces + 1).astype(int).tolist()
-    return [(row, row + 1, left, right) for row in range(rows) for left, right in zip(edges[:-1], edges[1:])]
+    with -inf beyond the ends, row k of the tip directly or (``swept[k]``) by the
+    envelope sweep. Plain Python, compiled by :func:`_kernel`."""
+    count, columns = image.shape
+    size = columns // tiles + 1 + 2 * (quadrant.shape[1] - 1)
+    line = np.empty(size)  # the two rows' maximum, with margins
+    stack = np.empty(size, np.int64)  # the sweep's points on the envelope, left to right ...
+    starts = np.empty(size, np.int64)  # ... and where each takes the lead
+    for task in range(first, last):
+        y = task // tiles
+        left = task % tiles * columns // tiles
+        width = (task % tiles + 1) * columns // tiles - left
+        best = out[y, left : left + width]
+        best[:] = -np.inf
+        for k in range(quadrant.shape[0]):
+            reach = widths[k]
+            above = y - k
+            below = y + k
+            if reach < 0 or (above < 0 and below >= count):
+                continue
+            if above < 0:
+                above = below
+            elif below >= count:
+                below = above
+            # line[j]: the higher of the two rows at the column left - reach + j
+            n = width + 2 * reach
+            inside = max(0, reach - left)
+            outside = min(n, columns - left + reach)
+            line[:inside] = -np.inf
+            line[outside:n] = -np.inf
+            upper = image[above, left - reach + inside : left - reach + outside]
+            lower = image[below, left - reach + inside : left - reach + outside]
+            middle = line[inside:outside]
+            for j in range(outside - inside):
+                u = upper[j]
+                v = lower[j]
+                middle[j] = u if u > v else v
+            lowering = quadrant[k]
+            if not swept[k]:
+                # directly: best[p] = max over x of max(line[p + reach ± x]) + lowering[x], two x at a time
+                centre = line[reach : reach + width]
+                c = lowering[0]
+                for p in range(width):
+                    u = centre[p] + c
+                    held = best[p]
+                    best[p] = u if u > held else held
+                x = 1
+                while x <= reach:
+                    c = lowering[x]
+                    right = line[reach + x : reach + x + width]
+                    left_ = line[reach - x : reach - x + width]
+                    if x < reach:
+                        d = lowering[x + 1]
+                        right2 = line[reach + x + 1 : reach + x + 1 + width]
+                        left2 = line[reach - x - 1 : reach - x - 1 + width]
+                        for p in range(width):
+                            u = right[p]
+                            v = left_[p]
+                            u = (u if u > v else v) + c
+                            w = right2[p]
+                            v = left2[p]
+                            w = (w if w > v else v) + d
+                            u = u if u > w else w
+                            held = best[p]
+                            best[p] = u if u > held else held
+                        x += 2
+                    else:
+                        for p in range(width):
+                            u = right[p]
+                            v = left_[p]
+                            u = (u if u > v else v) + c
+                            held = best[p]
+                            best[p] = u if u > held else held
+                        x += 1
+                continue
+            # the sweep: the point q of the line offers line[q] + lowering[|p - q|] to the
+            # positions p within reach; of two points a < b, b's offer gains on a's as p
+            # grows (the semicircles are equal and cross at most once), so the leaders
+            # from left to right form a stack, each with where it takes the lead
+            final = reach + width - 1
+            head = 0
+            tail = 0
+            b = 0
+            for p in range(reach, reach + width):
+                while b <= p + reach:  # the point coming within reach of p joins
+                    zb = line[b]
+                    if zb > -np.inf:
+                        s = p
+                        while tail > head:
+                            a = stack[tail - 1]
+                            t = max(starts[tail - 1], p)
+                            if t > a + reach:  # a leads nowhere from p on
+                                tail -= 1
+                                continue
+                            za = line[a]
+                            if zb + lowering[abs(t - b)] >= za + lowering[abs(t - a)]:
+                                tail -= 1  # b leads wherever a would have
+                                continue
+                            # the first position in (t, end] where b's offer reaches a's, end + 1
+                            # if none: where the semicircles about (a, za) and (b, zb) cross
+                            # (their upper intersection, on both upper halves), then
+                            # settled on the very sums compared above
+                            end = min(a + reach, final)
+                            s = end + 1
+                            run = (b - a) * dx
+                            rise = zb - za
+                            squared = run * run + rise * rise
+                            height = squared_radii[k] - 0.25 * squared
+                            if height > 0.0:
+                                ratio = math.sqrt(height / squared)
+                                if 0.5 * rise + ratio * run >= 0.0:
+                                    at = a + (0.5 * run - ratio * rise) / dx
+                                    if at <= t + 1:
+                                        s = t + 1
+                                    elif at < end + 1:
+                                        s = int(math.ceil(at))
+                            if s <= end and zb + lowering[abs(s - b)] < za + lowering[abs(s - a)]:
+                                s += 1
+                                while s <= end and zb + lowering[abs(s - b)] < za + lowering[abs(s - a)]:
+                                    s += 1
+                            else:
+                                while s - 1 > t and zb + lowering[abs(s - 1 - b)] >= za + lowering[abs(s - 1 - a)]:
+                                    s -= 1
+                            break
+                        stack[tail] = b
+                        starts[tail] = s
+                        tail += 1
+                    b += 1
+                while head < tail:  # leaders out of reach, or overtaken, go
+                    q = stack[head]
+                    if p > q + reach or (head + 1 < tail and starts[head + 1] <= p):
+                        head += 1
+                    else:
+                        break
+                if head < tail and starts[head] <= p:
+                    q = stack[head]
+                    u = line[q] + lowering[abs(p - q)]
+                    held = best[p - reach]
+                    best[p - reach] = u if u > held else held
 
 
 def _cores():
@@ -334,12 +503,14 @@ def _check_cost(heights, radius, spacing, passes=1):
     Why refuse the wider tip sooner: it rests, wherever it is, on a few of the scan's
     highest points, and its path depends on where the scan ends (nothing is assumed
     beyond), so minutes of exact work buy little that a resampled scan (the cost falls
-    as the fourth power of the spacing) does not show in seconds."""
+    as the third or fourth power of the spacing) does not show in seconds."""
     from ..units import format_length
 
     reach = _reach(radius, spacing, heights.shape)
-    kernel_points = math.prod(2 * r + 1 for r in reach)  # the compiled loops visit the whole box
-    seconds = heights.size * kernel_points * SECONDS_PER_COMPARISON / _cores()
+    # the rows' widths, as the tip's table has them but for an offset on the rim, whichever the rounding
+    rows = np.arange(reach[1] + 1) * spacing[1] if len(reach) == 2 else np.zeros(1)
+    widths = np.floor(np.sqrt(np.maximum(radius * radius * (1 + 1e-12) - rows**2, 0.0)) / spacing[0])
+    seconds = heights.size * _seconds_per_point(np.minimum(widths, reach[0])) / _cores()
     extents = [n * d for n, d in zip(reversed(heights.shape), spacing)]
     scan = " × ".join(format_length(extent, 4) for extent in extents)
     tip = f"a {format_length(radius, 4)} tip ({format_length(2 * radius, 4)} across)"
