@@ -154,6 +154,7 @@ class FakeHandle:
         self.closed = False
         self.nonblocking = False
         self.origin = None
+        self.scheduled = 0.0  # the delay of the scheduled report read last
 
     def set_nonblocking(self, value):
         self.nonblocking = bool(value)
@@ -169,9 +170,13 @@ class FakeHandle:
             return []
         delay, report = self.inputs[0]
         if delay is not None:
-            self.origin = self.origin or time.monotonic()
-            if self.origin + delay > time.monotonic():
+            now = time.monotonic()
+            self.origin = self.origin or now
+            if self.origin + delay - self.scheduled > now:
                 return []
+            # the next report's delay counts from now: a host that reads late still sees
+            # every report in a read of its own, as on an idle machine
+            self.origin, self.scheduled = now, delay
         self.inputs.pop(0)
         return list(report)
 
@@ -196,7 +201,8 @@ class FakeHandle:
 
     def schedule(self, delay, x=None, y=None, buttons=None):
         """Queue an input report that becomes readable ``delay`` seconds after the
-        host's first read of a scheduled report."""
+        host's first read of a scheduled report, measured as the gap to the previous
+        scheduled report from the moment the host read that one."""
         self.inputs.append((delay, self.device.input_report(x, y, buttons)))
 
     def _check(self):
