@@ -14,15 +14,7 @@ from rough.errors import FormatError
 from rough.io import read_bytes
 from rough.io.x3p import NAMESPACE, VENDOR_ID
 
-from x3p_files import x3p_file
-
-GRID = np.array([[1.0, 2.0, 3.0, 4.0], [5.0, 6.0, 7.0, 8.0], [9.0, 10.0, 11.0, 12.0]]) * 1e-6
-
-
-def written(surface):
-    buffer = io.BytesIO()
-    surface.write(buffer, "x3p")
-    return buffer.getvalue()
+from x3p_files import GRID, written, x3p_file
 
 
 def members(blob):

@@ -23,15 +23,7 @@ from rough.errors import FormatError, InputError
 from rough.io import limits, read_bytes, x3p
 
 from conftest import assert_one_line_error, rough
-from x3p_files import x3p_file
-
-GRID = np.array([[1.0, 2.0, 3.0, 4.0], [5.0, 6.0, 7.0, 8.0], [9.0, 10.0, 11.0, 12.0]]) * 1e-6
-
-
-def written(surface):
-    buffer = io.BytesIO()
-    surface.write(buffer, "x3p")
-    return buffer.getvalue()
+from x3p_files import GRID, written, x3p_file
 
 
 def data_bin(blob):

@@ -1,5 +1,5 @@
 """Hand-made X3P files for tests: every variation the reader must accept or refuse,
-written independently of rough's own writer."""
+written independently of rough's own writer (and ``written``: what that writer gives)."""
 
 import hashlib
 import io
@@ -8,6 +8,16 @@ import zipfile
 import numpy as np
 
 TYPES = {"I": "<i2", "L": "<i4", "F": "<f4", "D": "<f8"}
+
+
+GRID = np.array([[1.0, 2.0, 3.0, 4.0], [5.0, 6.0, 7.0, 8.0], [9.0, 10.0, 11.0, 12.0]]) * 1e-6  # a 4 × 3 map, m
+
+
+def written(surface):
+    """The bytes of ``surface`` written as X3P by rough."""
+    buffer = io.BytesIO()
+    surface.write(buffer, "x3p")
+    return buffer.getvalue()
 
 
 def x3p_file(

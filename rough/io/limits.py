@@ -90,12 +90,9 @@ def read_capped(stream, what):
     received = receive(stream, what, limit)
     if received is not None:
         return received
-    try:
-        status = os.fstat(stream.fileno())
-    except (OSError, AttributeError, ValueError, io.UnsupportedOperation):
-        status = None
-    if status is not None and stat.S_ISREG(status.st_mode):
-        if status.st_size > limit:
+    size = file_size(stream)
+    if size is not None:
+        if size > limit:
             raise _too_large(what, limit)
         return stream.read()
     parts, total = [], 0
@@ -105,6 +102,16 @@ def read_capped(stream, what):
         if total > limit:
             raise _too_large(what, limit)
     return b"".join(parts)
+
+
+def file_size(stream):
+    """The size in bytes of a stream that is a regular file, else None (a pipe, a
+    terminal, an in-memory stream)."""
+    try:
+        status = os.fstat(stream.fileno())
+    except (OSError, AttributeError, ValueError, io.UnsupportedOperation):
+        return None
+    return status.st_size if stat.S_ISREG(status.st_mode) else None
 
 
 def _too_large(what, limit):

@@ -58,7 +58,6 @@ import mmap
 import os
 import queue
 import re
-import stat
 import struct
 import threading
 import weakref
@@ -211,7 +210,7 @@ def receive(stream, what, limit):
     way: the CRC-32 in this thread, the MD5 in a worker thread, so hashing overlaps
     the reading and ends soon after the last byte arrives. :func:`read` takes those
     digests instead of hashing the data again."""
-    size = _file_size(stream)
+    size = limits.file_size(stream)
     try:  # a look at the first bytes that leaves a file's buffer empty (a later read() would join to it)
         head = os.pread(stream.fileno(), 4, stream.tell()) if size is not None else stream.peek(4)[:4]
         size = None if size is None else size - stream.tell()
@@ -265,15 +264,6 @@ class _Received(mmap.mmap):
     ``(size, (MD5 hex, CRC-32))``."""
 
     regions = {}
-
-
-def _file_size(stream):
-    """The size of a regular file, else None."""
-    try:
-        status = os.fstat(stream.fileno())
-    except (OSError, AttributeError, ValueError, io.UnsupportedOperation):
-        return None
-    return status.st_size if stat.S_ISREG(status.st_mode) else None
 
 
 def _address(data):

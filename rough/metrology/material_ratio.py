@@ -47,7 +47,7 @@ import math
 import numpy as np
 
 from ..errors import InputError
-from .parameters import BLOCK, ROUNDING, combined, map_profiles
+from .parameters import BLOCK, ROUNDING, combined, map_profiles, valid_values
 
 CENTRAL_REGION = 40.0  # % of material ratio, ISO 13565-2 and ISO 25178-2
 PROBABILITY_RANGE = 3.0  # standard deviations either side of the mean, ISO 13565-3
@@ -190,11 +190,7 @@ class MaterialRatioCurve:
     """
 
     def __init__(self, surface):
-        heights = np.asarray(getattr(surface, "heights", surface), dtype=np.float64).ravel()
-        total = heights.sum()
-        if not math.isfinite(total):
-            heights = heights[~np.isnan(heights)]
-            total = heights.sum()
+        heights, total = valid_values(np.asarray(getattr(surface, "heights", surface), dtype=np.float64))
         if heights.size < 2:
             raise InputError("the material-ratio curve needs at least two valid points")
         ordered = total / heights.size - heights  # one new array: sorted in place, turned descending

@@ -72,22 +72,28 @@ AREAL = {
 }
 
 
+def valid_values(heights):
+    """``(values, their sum)``: the valid points of ``heights`` as a flat array (a view,
+    without a copy, when there is no NaN) and their sum, the very one ``values.sum()``
+    and ``values.mean()`` take."""
+    values = heights.reshape(-1)
+    total = values.sum()
+    if not math.isfinite(total):
+        values = values[~np.isnan(values)]
+        total = values.sum()
+    return values, total
+
+
 def centring(heights):
     """``(mean, count, constant)`` of the valid points of ``heights``: their mean and
     number, and whether they differ from that mean only by its rounding (a constant
     surface, whose deviations count as exactly zero). Reads a NaN-free array without
     copying it."""
-    flat = heights.reshape(-1)
-    total = flat.sum()
-    if math.isfinite(total):
-        count = flat.size
-    else:
-        valid = flat[~np.isnan(flat)]
-        total, count = valid.sum(), valid.size
-    if not count:
+    values, total = valid_values(heights)
+    if not values.size:
         return math.nan, 0, False
-    mean = total / count
-    return mean, count, max(np.nanmax(flat) - mean, mean - np.nanmin(flat)) <= ROUNDING * abs(mean)
+    mean = total / values.size
+    return mean, values.size, max(values.max() - mean, mean - values.min()) <= ROUNDING * abs(mean)
 
 
 def centred(heights):
@@ -134,16 +140,21 @@ def amplitude(heights):
 def slopes(heights, spacing, method="2point", axis=-1):
     """Local slopes dz/dx along ``axis`` (NaN where a point needed is invalid):
     forward differences, or ISO 4287's seven-point formula on interior points."""
-    if method not in SLOPES:
-        raise InputError(f"slope method must be one of {', '.join(SLOPES)}, not {method!r}")
+    _check_slope(method, heights.shape[axis])
     if method == "2point":
         return np.diff(heights, axis=axis) / spacing
     from scipy.ndimage import correlate1d
 
-    if heights.shape[axis] < 7:
-        raise InputError("the seven-point slope needs at least 7 points along each axis")
     derivative = correlate1d(heights, SEVEN_POINT[::-1], axis=axis, mode="constant", cval=np.nan) / spacing
     return np.take(derivative, range(3, heights.shape[axis] - 3), axis=axis)
+
+
+def _check_slope(method, points):
+    """Refuse an unknown slope method, and the seven-point slope along fewer than 7 points."""
+    if method not in SLOPES:
+        raise InputError(f"slope method must be one of {', '.join(SLOPES)}, not {method!r}")
+    if method == "7point" and points < 7:
+        raise InputError("the seven-point slope needs at least 7 points along each axis")
 
 
 def profile_parameters(surface, sampling_lengths=5, slope="2point", jrc_spacing=0.5e-3, peak_band=0.05):
@@ -346,17 +357,15 @@ def gradient_means(surface, slope="2point"):
     Works a block of rows at a time."""
     z = surface.heights
     dx, dy = surface.spacing
-    if slope not in SLOPES:
-        raise InputError(f"slope method must be one of {', '.join(SLOPES)}, not {slope!r}")
-    halo = 0 if slope == "2point" else 3
-    if slope == "7point" and min(z.shape) < 7:
-        raise InputError("the seven-point slope needs at least 7 points along each axis")
+    _check_slope(slope, min(z.shape))
+    before = 0 if slope == "2point" else 3  # the rows a point's slope along y needs before it ...
+    after = max(before, 1)  # ... and after it
     sums, count = [], 0
     rows_per_block = max(1, BLOCK // z.shape[1])
-    for top in range(halo, z.shape[0] - max(halo, 1), rows_per_block):
-        bottom = min(top + rows_per_block, z.shape[0] - max(halo, 1))
+    for top in range(before, z.shape[0] - after, rows_per_block):
+        bottom = min(top + rows_per_block, z.shape[0] - after)
         gx = slopes(z[top:bottom], dx, slope, axis=1)
-        gy = slopes(z[top - halo : bottom + max(halo, 1)], dy, slope, axis=0)
+        gy = slopes(z[top - before : bottom + after], dy, slope, axis=0)
         squared = gx**2 + gy[:, :-1] ** 2 if slope == "2point" else gx**2 + gy[:, 3:-3] ** 2
         squared = squared[~np.isnan(squared)]
         sums.append((squared.sum(), (np.sqrt(1.0 + squared) - 1.0).sum()))
