@@ -16,6 +16,7 @@ EXTRAS = {
     "matplotlib": ("--plot", "matplotlib", "plot"),
     "hidraw": ("the HID joystick", "hidapi", "haptics"),
     "hidtools": ("the HID joystick", "hid-tools", "haptics"),
+    "evdev": ("an evdev force-feedback device", "evdev", "haptics"),
     "statsmodels": ("the experiment's analysis", "statsmodels", "experiment"),
     "h5py": ("reading HDF5", "h5py", "formats"),
     "igor2": ("reading Igor IBW", "igor2", "formats"),

@@ -9,11 +9,11 @@ import pathlib
 import numpy as np
 import pytest
 
+import rough.cli.main as cli_main
 import rough.experiment.session as session
 import rough.io.atomic as atomic
 import rough.render.loop as loop
 import rough.render.session as render_session
-from rough.cli import main as cli_main
 from rough.errors import InputError
 from rough.experiment.design import grid_design, load_study, write_study
 from rough.render import QuasiStatic, Settings, SimulatedHand, Track, run, simulate

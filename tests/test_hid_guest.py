@@ -4,54 +4,14 @@ uhid, hid-tools serving its side, and runs ``rough render --device hid`` against
 (tests/vhid_guest.py). The guest is built once into build/vhid (or $ROUGH_VHID); this
 needs qemu-system-x86 and root for apt-get, which .ci/run provides. Elsewhere it skips."""
 
-import json
-import os
-import shutil
-import subprocess
-import sys
-
 import pytest
-
-from conftest import ROOT, shared_folder
-
-
-@pytest.fixture(scope="module")
-def guest():
-    folder = ROOT / "build" / "vhid" if not os.environ.get("ROUGH_VHID") else os.environ["ROUGH_VHID"]
-    folder = type(ROOT)(folder)
-    shared = shared_folder()
-    if shared is None:
-        pytest.skip("../shared/reference/virtual-hid (the guest recipe) is not beside this checkout")
-    recipe = shared / "reference" / "virtual-hid"
-    if not (folder / "initrd.img").exists():
-        if shutil.which("qemu-system-x86_64") is None:
-            pytest.skip("qemu-system-x86 is not installed (.ci/run installs it)")
-        if os.geteuid() != 0 or shutil.which("apt-get") is None:
-            pytest.skip("building the guest needs root and apt-get (Debian's kernel and busybox packages)")
-        built = subprocess.run(
-            ["bash", str(recipe / "build.sh"), str(folder)], capture_output=True, text=True, timeout=1200, check=False
-        )
-        if built.returncode != 0 or not (folder / "initrd.img").exists():
-            reason = (built.stderr or built.stdout).strip().splitlines()[-1:] or ["no output"]
-            pytest.skip(f"the guest could not be built: {reason[0]}")
-    return recipe, folder
+from guest import boot, guest_image, guest_python
 
 
 @pytest.fixture(scope="module")
-def outcome(guest):
-    recipe, folder = guest
-    console = subprocess.run(
-        ["bash", str(recipe / "run.sh"), str(folder), sys.executable, str(ROOT / "tests" / "vhid_guest.py")],
-        capture_output=True,
-        text=True,
-        timeout=900,
-        check=False,
-    )
-    lines = [
-        line[line.index("RESULT {") + len("RESULT ") :] for line in console.stdout.splitlines() if "RESULT {" in line
-    ]
-    assert lines, f"the guest printed no result:\n{console.stdout[-3000:]}\n{console.stderr[-2000:]}"
-    return json.loads(lines[-1])
+def outcome(tmp_path_factory):
+    image = guest_image()
+    return boot(image, guest_python(tmp_path_factory.mktemp("guest-python")), "vhid_guest.py", "vhid guest: started")
 
 
 def test_rough_finds_the_joystick_and_sets_up_two_constant_force_effects(outcome):

@@ -14,6 +14,7 @@ from rough.errors import InputError
 from rough.fractal.resample import resample
 from rough.fractal.synth import synthesize_fragments, synthesize_profile
 from rough.render import DynamicStylus, QuasiStatic, Settings, Track, clamp, forces, run, simulate, write_trace
+from rough.render.device import Capabilities
 from rough.render.friction import CoulombViscous, Dahl, Karnopp, parse_friction
 from rough.render.loop import LoopStalled, _Watchdog
 
@@ -222,7 +223,8 @@ def test_whole_length_fractal_is_followed_at_every_speed():
 class ScriptedDevice:
     """A device that replays positions and buttons, records forces, and can fail."""
 
-    needs_watchdog = False
+    label, velocity = "scripted", (0.0, 0.0)
+    capabilities = Capabilities(needs_watchdog=False, simulated=True)
 
     def __init__(self, positions, fail_at=None, error=KeyboardInterrupt, stall_at=None):
         self.positions, self.fail_at, self.error, self.stall_at = positions, fail_at, error, stall_at
@@ -244,6 +246,9 @@ class ScriptedDevice:
 
     def emergency_stop(self):
         self.stopped = True
+        self.written.append((0.0, 0.0))
+
+    def zero(self):
         self.written.append((0.0, 0.0))
 
     def close(self):
@@ -286,7 +291,7 @@ def test_ctrl_c_and_errors_leave_the_force_at_zero(error, ended_by):
 
 def test_the_watchdog_zeroes_the_force_when_the_loop_stalls():
     device = ScriptedDevice([(5e-3, -1e-3, 0)], stall_at=40)
-    device.needs_watchdog = True
+    device.capabilities = Capabilities(needs_watchdog=True)
     with pytest.raises(LoopStalled, match="stalled"):
         run(device, [FLAT], QuasiStatic(), None, Settings(duration=2.0, watchdog=0.05, realtime=True))
     assert device.stopped and device.closed
@@ -548,7 +553,7 @@ def test_a_stalled_loop_is_zeroed_by_its_watchdog():
     watchdog's own logic, tested against a controllable clock above; bench/bench_render.py
     measures it on the machine.)"""
     device = TimedDevice([(5e-3, -1e-3, 0)], spin_at=30)
-    device.needs_watchdog = True
+    device.capabilities = Capabilities(needs_watchdog=True)
     with pytest.raises(LoopStalled):
         run(device, [FLAT], QuasiStatic(), None, Settings(duration=2.0, watchdog=2e-3, realtime=True))
     stop = device.written.index((0.0, 0.0))

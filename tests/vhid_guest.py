@@ -9,10 +9,8 @@ destroyed while rough streams forces.
 """
 
 import json
-import os
 import pathlib
 import signal
-import subprocess
 import sys
 import threading
 import time
@@ -21,6 +19,7 @@ HERE = pathlib.Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
 import numpy as np
+from guest_tools import ending, scratch_folder, start_render
 from hidtools.uhid import UHIDDevice
 from virtual_joystick import PidJoystick
 
@@ -72,27 +71,7 @@ def profiles(folder):
 
 
 def start_rough(folder, *extra):
-    command = [
-        sys.executable,
-        "-m",
-        "rough",
-        "render",
-        "--device",
-        f"hid:{VID:04x}:{PID:04x}",
-        "--rate",
-        "200",
-        "--ramp",
-        "0",
-        "--stick-span",
-        "10mm,4mm",
-        "--watchdog",
-        "1s",
-        "--json",
-        *extra,
-        str(folder / "a.x3p"),
-        str(folder / "b.x3p"),
-    ]
-    return subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    return start_render(folder, f"hid:{VID:04x}:{PID:04x}", *extra)
 
 
 def plug_in(x):
@@ -193,41 +172,12 @@ def unplug(folder):
     stop.set()
     time.sleep(0.05)
     device.destroy()
-    gone = time.monotonic()
-    try:
-        _, err = rough.communicate(timeout=30)
-        hung = False
-    except subprocess.TimeoutExpired:
-        rough.kill()
-        _, err = rough.communicate()
-        hung = True
-    return {
-        "streaming": streaming,
-        "returncode": rough.returncode,
-        "stderr": err,
-        "hung": hung,
-        "exit_after_s": time.monotonic() - gone,
-    }
-
-
-def scratch_mount():
-    """A folder to mount a tmpfs on (the host's root is read-only in the guest) that hides
-    none of the files this run needs: the interpreter, rough and these tests may all live
-    under /tmp (a wheel installed into a temporary environment)."""
-    needed = [pathlib.Path(p).resolve() for p in (sys.prefix, sys.exec_prefix, HERE)]
-    needed.append(pathlib.Path(sys.modules["rough"].__file__).resolve().parent)
-    for candidate in map(pathlib.Path, ("/media", "/srv", "/mnt", "/tmp")):
-        if candidate.is_dir() and not any(candidate == n or candidate in n.parents for n in needed):
-            return candidate
-    raise SystemExit("no folder to mount a tmpfs on that hides nothing this run needs")
+    return {"streaming": streaming, **ending(rough, time.monotonic())}
 
 
 def main():
-    mount_point = scratch_mount()
-    subprocess.run(["mount", "-t", "tmpfs", "tmpfs", str(mount_point)], check=True)
-    folder = mount_point / "rough-guest"
-    folder.mkdir()
-    os.chdir(folder)
+    print("vhid guest: started", flush=True)
+    folder = scratch_folder()
     first, second = profiles(folder)
     result = {"session": session(folder, first, second), "unplug": unplug(folder)}
     print("RESULT " + json.dumps(result, default=float), flush=True)

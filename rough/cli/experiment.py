@@ -187,6 +187,9 @@ def run(study, subject, haptics, observer, speed, stroke, realtime):
     if haptics.simulated:
         if observer is None:
             raise InputError("the simulated hand needs a scripted --observer (e.g. --observer rq=12,dimension=-4)")
+        from ..render.hand import HAND_DAMPING
+
+        haptics.warn_if_unstable(HAND_DAMPING)
         present = simulated_presenter(
             loaded, parse_observer(observer), speed, contact, friction, haptics.settings(stroke, realtime)
         )
@@ -205,16 +208,19 @@ def _joystick_session(study, subject, haptics, contact, friction):
     from .. import read
     from ..experiment.session import Keyboard, joystick_presenter, run_session
     from ..render import Track
-    from ..render.session import open_joystick
+    from ..render.session import fitted_model, open_joystick
 
     tracks = {name: Track.from_surface(read(study.surface_path(name))) for name in study.surfaces}
-    joystick, label = open_joystick(
+    joystick, _ = open_joystick(
         haptics.device, list(tracks.values()), haptics.max_force, haptics.stick_span, haptics.invert
     )
+    model = fitted_model(contact, joystick)
+    if model is contact:
+        haptics.warn_if_unstable()
     keyboard = Keyboard()
     try:
-        present = joystick_presenter(tracks, joystick, contact, friction, haptics.settings(), keyboard)
-        return run_session(study, subject, present, label)
+        present = joystick_presenter(tracks, joystick, model, friction, haptics.settings(), keyboard)
+        return run_session(study, subject, present, joystick.label)
     finally:
         keyboard.close()
         joystick.close()

@@ -1,5 +1,6 @@
 """Options shared by the commands that drive a haptic device (render, experiment run):
-the device, the contact and friction models, the servo loop's settings."""
+the device, the contact and friction models, the servo loop's settings, the stability
+check."""
 
 import dataclasses
 import functools
@@ -9,6 +10,7 @@ import click
 from .options import SPACING, QuantityType
 
 MAX_RATE = 100e3  # Hz: a Python tick takes a few microseconds; no device or model needs more
+BACKEND_MODULES = {"hid": ("hidraw", "hidtools"), "evdev": ("evdev",)}  # the extras each device needs
 
 
 class PositiveQuantity(QuantityType):
@@ -42,6 +44,20 @@ MAX_FORCE = PositiveQuantity("force", "N")
 RAMP = QuantityType("time", "s")
 
 
+class CouplingType(click.ParamType):
+    """``K,B``: the virtual coupling's stiffness and damping → (N/m, N·s/m)."""
+
+    name = "K,B"
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, tuple):
+            return value
+        parts = value.split(",")
+        if len(parts) != 2:
+            self.fail(f"{value!r}: give K,B, e.g. 0.8N/mm,0N*s/m", param, ctx)
+        return STIFFNESS.convert(parts[0], param, ctx), DAMPING.convert(parts[1], param, ctx)
+
+
 @dataclasses.dataclass(frozen=True)
 class Haptics:
     """The device and loop options as given (SI units)."""
@@ -60,15 +76,51 @@ class Haptics:
     velocity_filter: float
     watchdog: float
     priority: int
+    coupling: tuple
+    device_damping: float
 
     @property
     def simulated(self):
-        return self.device == "sim"
+        from ..render.device import is_simulated
+
+        return is_simulated(self.device)
 
     def contact(self):
+        """The profile's contact model, behind the virtual coupling if one was asked for."""
         from ..render.session import make_model
 
-        return make_model(self.model, self.stiffness, self.mass, self.damping, 1.0 / self.rate)
+        model = make_model(self.model, self.stiffness, self.mass, self.damping, 1.0 / self.rate)
+        if self.coupling is None:
+            return model
+        from ..render.stability import VirtualCoupling
+
+        if self.model != "quasi-static":
+            raise click.BadParameter("the virtual coupling wraps the quasi-static model", param_hint="--coupling")
+        return VirtualCoupling(model, *self.coupling, period=1.0 / self.rate)
+
+    def field(self, load):
+        """The map's gradient field with the normal load ``load`` (N)."""
+        from ..render.contact import GradientField
+
+        if self.model != "quasi-static" or self.coupling is not None:
+            raise click.BadParameter(
+                "a map is felt through the lateral gradient field; --model dynamic and --coupling apply to profiles",
+                param_hint="--model/--coupling",
+            )
+        return GradientField(load)
+
+    def warn_if_unstable(self, damping=None):
+        """Log one warning when the contact stiffness exceeds the passivity bound at
+        this rate for a device of damping ``damping`` (N·s/m; default
+        ``--device-damping``) and no coupling holds it."""
+        import logging
+
+        from ..render.stability import stability_warning
+
+        b = self.device_damping if damping is None else damping
+        message = stability_warning(self.stiffness, self.rate, b, self.coupling)
+        if message:
+            logging.getLogger("rough").warning(message)
 
     def friction_model(self):
         from ..render.friction import parse_friction
@@ -97,14 +149,16 @@ def haptic_options(command):
 
     @functools.wraps(command)
     def wrapper(*args, **kwargs):
-        values = {name: kwargs.pop(name) for name in names}
-        if values["device"] != "sim" and not values["device"].startswith("hid"):
-            raise click.BadParameter(f"{values['device']!r}: use sim, hid or hid:VID:PID", param_hint="--device")
-        if values["device"].startswith("hid"):
-            from ..extras import require
+        from ..extras import require
+        from ..render.device import DeviceError, parse_device
 
-            require("hidraw")
-            require("hidtools")
+        values = {name: kwargs.pop(name) for name in names}
+        try:
+            backend, _ = parse_device(values["device"])
+        except DeviceError as error:
+            raise click.BadParameter(str(error).partition(": ")[2], param_hint="--device") from None
+        for module in BACKEND_MODULES.get(backend, ()):
+            require(module)
         return command(*args, haptics=Haptics(**values), **kwargs)
 
     options = [
@@ -112,9 +166,10 @@ def haptic_options(command):
             "--device",
             default="sim",
             show_default=True,
-            metavar="sim|hid[:VID:PID]",
-            help="sim: a simulated hand; hid: the first HID PID force-feedback joystick (or the one with "
-            "these hex IDs).",
+            metavar="sim|hid[:VID:PID]|evdev[:PATH]",
+            help="sim: a simulated hand; hid: the first HID PID force-feedback joystick through hidraw (or the "
+            "one with these hex IDs); evdev: the first Linux force-feedback device (or /dev/input/eventN), "
+            "through its kernel driver.",
         ),
         click.option("--rate", type=RATE, default="1kHz", show_default=True, help="Servo rate."),
         click.option(
@@ -152,14 +207,19 @@ def haptic_options(command):
             "--stick-span",
             type=SPACING,
             metavar="X,Y",
-            help="hid: lengths the stick's full x and y travel cover (default: the window, and 4× the "
-            "profile's height range).",
+            help="Joysticks: lengths the stick's full x and y travel cover (default: the window, and 4× the "
+            "profile's height range; on a map, the map's extent).",
         ),
         click.option(
-            "--invert", type=click.Choice(["x", "y"]), multiple=True, help="hid: reverse an axis (position and force)."
+            "--invert",
+            type=click.Choice(["x", "y"]),
+            multiple=True,
+            help="Joysticks: reverse an axis (position and force).",
         ),
         click.option(
-            "--ramp", type=RAMP, help="Ramp the force in over this time at the start (default: hid 0.5 s, sim none)."
+            "--ramp",
+            type=RAMP,
+            help="Ramp the force in over this time at the start (default: joysticks 0.5 s, sim none).",
         ),
         click.option(
             "--velocity-filter",
@@ -173,7 +233,7 @@ def haptic_options(command):
             type=TIME,
             default="10ms",
             show_default=True,
-            help="hid: zero the force if the loop stalls this long.",
+            help="Joysticks: zero the force if the loop stalls this long.",
         ),
         click.option(
             "--priority",
@@ -181,6 +241,21 @@ def haptic_options(command):
             default=50,
             show_default=True,
             help="Real-time loops: run at SCHED_FIFO priority N where permitted (0: normal scheduling).",
+        ),
+        click.option(
+            "--coupling",
+            type=CouplingType(),
+            help="Render the quasi-static contact through a virtual coupling of stiffness K and damping B (e.g. "
+            "0.8N/mm,0N*s/m), which keeps it passive when K T/2 + B stays below the device's damping.",
+        ),
+        click.option(
+            "--device-damping",
+            type=DAMPING,
+            default="0.45N*s/m",
+            show_default=True,
+            help="Joysticks: the device's own damping b, for the passivity bound K ≤ 2b/T (Colgate & Schenkel); "
+            "the default is an assumption that puts the bound at 0.9 N/mm at 1 kHz, near the stiffness Choi & Tan "
+            "rendered cleanly. Measure your device's b and give it here. The simulated hand uses --hand-damping.",
         ),
     ]
     for option in reversed(options):

@@ -39,7 +39,7 @@ TEXT = (
     "               uncertainty.\n"
     "  formats      The file formats rough reads and writes, and what each carries.\n"
     "  info         Shape, spacing, size, valid points, z range, Rq/Sq and history.\n"
-    "  render       The haptic contact loop on a USB force-feedback joystick or a\n"
+    "  render       The haptic contact loop on a force-feedback joystick or a\n"
     "               simulated hand.\n"
     "  resample     Resample to a new spacing without aliasing.\n"
     "  rose         D(θ) and C(θ) by direction for maps (the amplitude coefficient\n"

@@ -1,4 +1,7 @@
-"""rough render: feel a profile through a force-feedback joystick, or a simulated hand."""
+"""rough render: feel a profile or a map through a force-feedback joystick, or a simulated hand."""
+
+import functools
+import math
 
 import click
 
@@ -7,7 +10,7 @@ from .options import CROP, POSITION, TIP, input_options, plot_option, report_for
 from .report import Report, on_stdout, shown
 
 
-@click.command(short_help="The haptic contact loop on a USB force-feedback joystick or a simulated hand.")
+@click.command(short_help="The haptic contact loop on a force-feedback joystick or a simulated hand.")
 @input_options(together=2)
 @haptic_options
 @click.option(
@@ -19,8 +22,16 @@ from .report import Report, on_stdout, shown
     help="sim: stroke speed (default 20mm/s, slow enough to feel each feature; experiment run strokes at "
     "60mm/s; repeat for several runs, e.g. --speed 20mm/s --speed 120mm/s). A bare number is in mm/s.",
 )
-@click.option("--duration", type=TIME, help="Run length (default: sim one pass over the window; hid until Ctrl-C).")
-@click.option("--press", type=FORCE, default="1N", show_default=True, help="sim: the hand's downward push.")
+@click.option(
+    "--duration", type=TIME, help="Run length (default: sim one pass over the window; joysticks until Ctrl-C)."
+)
+@click.option(
+    "--press",
+    type=FORCE,
+    default="1N",
+    show_default=True,
+    help="sim: the hand's downward push; maps: the normal load N of the lateral force -N·∇h (every device).",
+)
 @click.option("--hand-mass", type=MASS, default="150g", show_default=True, help="sim: the hand's mass.")
 @click.option("--hand-damping", type=DAMPING, default="2N*s/m", show_default=True, help="sim: the hand's damping.")
 @click.option(
@@ -31,9 +42,27 @@ from .report import Report, on_stdout, shown
 @click.option(
     "--realtime", is_flag=True, help="sim: pace the loop in real time (as a joystick is) instead of running flat out."
 )
-@click.option("--row", type=POSITION, help="Maps: render the row at this y position (default the middle row).")
 @click.option(
-    "--crop", "window", type=CROP, help="The profile window X0:X1 to render (lengths; positions include the origin)."
+    "--direction",
+    type=click.FloatRange(-360, 360),
+    default=0.0,
+    show_default=True,
+    metavar="DEGREES",
+    help="sim on maps: stroke along this direction (degrees from +x), through the map's centre.",
+)
+@click.option(
+    "--turn",
+    type=TIME,
+    default="0.2s",
+    show_default=True,
+    help="sim: the time the hand takes to reverse, when --duration is longer than one pass (back-and-forth strokes).",
+)
+@click.option("--row", type=POSITION, help="Maps: render only the row at this y position, as a profile.")
+@click.option(
+    "--crop",
+    "window",
+    type=CROP,
+    help="The window X0:X1 to render (X0:X1,Y0:Y1 on a map; lengths; positions include the origin).",
 )
 @click.option("--fill", is_flag=True, help="Fill invalid points first (linear interpolation).")
 @click.option(
@@ -60,6 +89,8 @@ def render(
     hand_damping,
     hand_stiffness,
     realtime,
+    direction,
+    turn,
     row,
     window,
     fill,
@@ -67,13 +98,17 @@ def render(
     trace,
     plot,
 ):
-    """Run the haptic contact loop on the profile INPUT (default: standard input): a
-    virtual stylus rides the profile and the contact force (F_y = K·penetration,
-    F_x = -F_y·h', resisting the climb) goes to the device, once per servo period,
-    paced by a deadline clock. A second INPUT is a second surface: the joystick's
-    trigger switches between them. The run ends after --duration or on Ctrl-C; the force
-    is zeroed however it ends. Prints the loop's timing (achieved rate, period jitter,
-    missed deadlines) and the force statistics.
+    """Run the haptic contact loop on the profile or map INPUT (default: standard
+    input), once per servo period, paced by a deadline clock. On a profile a virtual
+    stylus rides it: the stick's x moves along the profile, its y presses into it, and
+    the contact force (F_y = K·penetration, F_x = -F_y·h', resisting the climb) goes to
+    the device. On a map the stick's x and y move a point over the map, which pushes
+    the hand down the local slope with F = -N·∇h (Minsky's lateral-gradient texture, N
+    the --press), so a 2-axis joystick feels the whole map, its lay and anisotropy.
+    A second INPUT is a second surface: the trigger switches between them. The run
+    ends after --duration or on Ctrl-C; the force is zeroed however it ends. Prints
+    the loop's timing (achieved rate, period jitter, missed deadlines) and the force
+    statistics; warns when --stiffness exceeds the device's passivity bound.
 
     \b
     Examples:
@@ -81,47 +116,78 @@ def render(
             | rough render --speed 20mm/s --speed 60mm/s --speed 120mm/s --trace forces-{speed}.tsv --plot forces.png
         rough render --model dynamic --friction karnopp:static=0.8N,coulomb=0.5N rock.x3p
         rough render --device hid --stick-span 80mm,10mm rough.x3p smooth.x3p
+        rough render --device evdev:/dev/input/event5 --stick-span 20mm,20mm bedding-plane.x3p
+        rough render --duration 60s --direction 90 --trace across.tsv lay.x3p
         rough render --tip fingertip --speed 60mm/s fossil.x3p
     """
-    from ..render import Track
-    from ..render.session import run_hid, run_sim, summary_rows
+    from ..render import MapTrack
+    from ..render.session import run_sim, run_stick, summary_rows
 
     report = not on_stdout(trace=trace, plot=plot)
     if trace == "-" and len(speeds) > 1:
         raise click.BadParameter("with several speeds, the traces need file names with {speed}", param_hint="--trace")
     if trace and len(speeds) > 1 and "{speed}" not in trace:
         raise click.BadParameter("with several speeds, put {speed} in the trace file name", param_hint="--trace")
-    tracks = []
-    for surface in surfaces:
-        if window is not None:
-            surface = surface.crop(window[0], window[1] if not surface.is_profile else None)
-        if fill:
-            from ..fractal.resample import fill_invalid
-
-            surface = fill_invalid(surface)
-        if tip is not None:
-            from ..metrology.tip import traced
-
-            surface = traced(surface, tip)
-        tracks.append(Track.from_surface(surface, row=row))
+    tracks = [_track(surface, window, fill, tip, row) for surface in surfaces]
+    if len({type(track) for track in tracks}) > 1:
+        raise click.BadParameter("the two surfaces must both be profiles or both maps (or give --row)")
     settings = haptics.settings(duration, realtime)
-    contact, friction = haptics.contact(), haptics.friction_model()
+    on_map = isinstance(tracks[0], MapTrack)
+    contact = haptics.field(press) if on_map else haptics.contact()
+    friction = haptics.friction_model()
     if haptics.simulated:
-        runs = run_sim(
-            tracks[0],
-            speeds or (0.02,),
-            contact,
-            friction,
-            settings,
-            press=press,
-            hand_mass=hand_mass,
-            hand_damping=hand_damping,
-            lateral_stiffness=hand_stiffness,
-        )
+        if not on_map:
+            haptics.warn_if_unstable(hand_damping)
+        hand = dict(hand_mass=hand_mass, hand_damping=hand_damping, lateral_stiffness=hand_stiffness, turn=turn)
+        if on_map:
+            hand["direction"] = math.radians(direction)
+        else:
+            hand["press"] = press
+        runs = run_sim(tracks[0], speeds or (0.02,), contact, friction, settings, **hand)
     else:
-        runs = [run_hid(haptics.device, tracks, contact, friction, settings, haptics.stick_span, haptics.invert)]
+        runs = [
+            run_stick(
+                haptics.device,
+                tracks,
+                functools.partial(_model_for, haptics, contact, press),
+                friction,
+                settings,
+                haptics.stick_span,
+                haptics.invert,
+            )
+        ]
     _outputs(runs, trace, plot, shown(inputs[0]))
-    return Report(*summary_rows(runs, haptics.model, contact, haptics.friction)) if report else None
+    return Report(*summary_rows(runs, haptics.friction)) if report else None
+
+
+def _model_for(haptics, contact, press, device):
+    """The model for ``device`` once open (a wheel feels a profile's lateral force
+    alone), checked against the passivity bound when it is a contact model."""
+    from ..render.session import fitted_model
+
+    model = fitted_model(contact, device, press)
+    if model is contact and hasattr(contact, "stiffness"):
+        haptics.warn_if_unstable()
+    return model
+
+
+def _track(surface, window, fill, tip, row):
+    """The Track (a profile, or a map's row) or MapTrack that ``surface`` is rendered as."""
+    from ..render import MapTrack, Track
+
+    if window is not None:
+        surface = surface.crop(window[0], window[1] if not surface.is_profile else None)
+    if fill:
+        from ..fractal.resample import fill_invalid
+
+        surface = fill_invalid(surface)
+    if tip is not None:
+        from ..metrology.tip import traced
+
+        surface = traced(surface, tip)
+    if surface.is_profile or row is not None:
+        return Track.from_surface(surface, row=row)
+    return MapTrack.from_surface(surface)
 
 
 def _outputs(runs, trace, plot, title):

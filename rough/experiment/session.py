@@ -325,26 +325,6 @@ def simulated_presenter(study, observer, speed, model, friction, settings, **han
     return present
 
 
-class HeldOpen:
-    """A device whose ``close`` only zeroes the force, so one joystick serves many trials."""
-
-    def __init__(self, device):
-        self.device = device
-        self.needs_watchdog = getattr(device, "needs_watchdog", False)
-
-    def read(self):
-        return self.device.read()
-
-    def write(self, fx, fy):
-        self.device.write(fx, fy)
-
-    def emergency_stop(self):
-        self.device.emergency_stop()
-
-    def close(self):
-        self.device.write(0.0, 0.0)
-
-
 class Keyboard:
     """Keys 1 and 2 from standard input, read by a background thread (single key
     presses on a terminal, lines otherwise)."""
@@ -385,6 +365,7 @@ def joystick_presenter(tracks, joystick, model, friction, settings, keyboard):
     """Present a trial on the joystick until the subject answers; ``tracks`` maps every
     surface name of the study to its :class:`~rough.render.Track`, read before the first
     trial so that trials follow each other without a pause."""
+    from ..render.device import HeldOpen
     from ..render.loop import run
 
     held = HeldOpen(joystick)
@@ -412,5 +393,5 @@ def _wait_for_release(device, timeout=5.0):
     """Wait (force zero) until the answer button is let go, so it does not answer the next trial too."""
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline and device.read()[2] & (2 | 4):
-        device.write(0.0, 0.0)
+        device.zero()
         time.sleep(0.005)

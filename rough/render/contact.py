@@ -205,6 +205,40 @@ class DynamicStylus:
         self.position, self.velocity = position, velocity
 
 
+class GradientField:
+    """Minsky's lateral-gradient texture, for a point moving over a map.
+
+    The hand, pressing with the normal load ``N``, feels ``F = -N ∇h`` in the plane
+    of the map: the 2-D form of the profile models' lateral term ``F_x = -F_y h'``
+    with ``F_y = N``. Along the motion it resists the climb; across the motion it
+    pushes down the slope. No state: ``reset()`` does nothing.
+
+    Parameters
+    ----------
+    load : float, default 1.0
+        The normal load N, newtons.
+
+    Raises
+    ------
+    ValueError
+        For a load that is negative or not finite.
+
+    Examples
+    --------
+    >>> from rough.render.contact import GradientField
+    >>> GradientField(2.0).load  # N
+    2.0
+    """
+
+    def __init__(self, load=1.0):
+        if not 0 <= load < math.inf:
+            raise ValueError("the normal load must be finite and not negative")
+        self.load = float(load)
+
+    def reset(self, y=None):
+        """No state to reset."""
+
+
 def zero_order_hold(stiffness, damping, mass, period):
     """The exact step of ``m ẍ = F - k x - b ẋ`` over ``period`` with F held constant:
     ``(Φ11, Φ12, Φ21, Φ22, Γ1, Γ2)`` such that ``x' = Φ11 x + Φ12 v + Γ1 F`` and

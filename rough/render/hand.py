@@ -1,30 +1,107 @@
 """A simulated hand on a simulated joystick: the ``sim`` device.
 
-The hand strokes along x at a constant ``speed`` while pressing down with the force
-``press``, through its own ``mass`` and ``damping`` (docs/math.rst §5.5's illustration: a
-0.15 kg hand with 2 N·s/m pushing down with 1 N). Along x it follows its stroke
-rigidly, unless ``lateral_stiffness`` (N/m, with ``lateral_damping``) lets the
-lateral and friction forces push it off its path. The force the loop writes is held
-for one servo period, as a device holds it, and the hand's motion over that period
-is integrated exactly (zero-order hold), so the simulation is as stable as the
+On a profile (:class:`SimulatedHand`) the hand strokes along x while pressing down with
+the force ``press``, through its own ``mass`` and ``damping`` (docs/math.rst §5.5's
+illustration: a 0.15 kg hand with 2 N·s/m pushing down with 1 N). On a map
+(:class:`MapHand`) it strokes in the plane of the map along a direction. Along its
+stroke it moves rigidly, unless ``lateral_stiffness`` (N/m, with ``lateral_damping``)
+lets the lateral and friction forces push it off its path. The force the loop writes
+is held for one servo period, as a device holds it, and the hand's motion over that
+period is integrated exactly (zero-order hold), so the simulation is as stable as the
 sampled system it imitates.
+
+A :class:`Stroke` says where the hand is along its stroke: one way at constant speed,
+or back and forth over a window, slowing down into each turn and speeding up out of
+it as a hand does.
 """
 
+import math
+
 from .contact import zero_order_hold
+from .device import Capabilities
 
 HAND_MASS = 0.15  # kg
 HAND_DAMPING = 2.0  # N·s/m
 PRESS = 1.0  # N
+TURN = 0.2  # s: the time a hand takes to reverse its stroke
+
+
+class Stroke:
+    """Where a hand stroking at ``speed`` is along its stroke, tick by tick.
+
+    One way (no ``length``): ``s = speed × k × period`` at constant speed. Back and
+    forth over ``[0, length]``: the hand starts at 0 at full speed, and at each end
+    turns in ``turn`` seconds, its velocity ``speed × cos(π τ / turn)`` through the
+    turn (so it slows into the end, stops there and speeds up on the way back: a
+    peak acceleration of π speed / turn). The turn begins ``d = speed × turn / π``
+    before the end; a turn that would need more than a quarter of the window is made
+    shorter.
+
+    Parameters
+    ----------
+    speed : float
+        The stroking speed, m/s.
+    period : float
+        The servo period, s.
+    length : float, optional
+        The window to stroke back and forth over, m; default one way.
+    turn : float, default 0.2
+        Seconds to reverse.
+
+    Examples
+    --------
+    Back and forth over 10 mm at 20 mm/s: the hand reaches the far end at 0.536 s,
+    almost at rest, and comes back:
+
+    >>> from rough.render.hand import Stroke
+    >>> stroke = Stroke(0.02, 1e-3, length=0.01)
+    >>> [round(stroke.at(k)[0] * 1e3, 3) for k in (0, 250, 536, 1000)]  # mm
+    [0.0, 5.0, 10.0, 1.454]
+    >>> [round(stroke.at(k)[1] * 1e3, 3) for k in (250, 536, 800)]  # mm/s
+    [20.0, 0.106, -20.0]
+    """
+
+    def __init__(self, speed, period, length=None, turn=TURN):
+        self.speed, self.period, self.length = float(speed), float(period), length
+        if length is not None:
+            self.turn = min(turn, math.pi * length / (4.0 * abs(self.speed)))
+            self.rim = abs(self.speed) * self.turn / math.pi
+            self.cruise = (length - 2.0 * self.rim) / abs(self.speed)
+            self.first = (length - self.rim) / abs(self.speed)
+            self.cycle = 2.0 * (self.turn + self.cruise)
+
+    def at(self, k):
+        """``(s, v)`` after ``k`` ticks: the distance along the stroke (m) and the
+        velocity along it (m/s)."""
+        if self.length is None:
+            return self.speed * k * self.period, self.speed
+        t, v = k * self.period, abs(self.speed)
+        if t < self.first:
+            return v * t, v
+        tau = (t - self.first) % self.cycle
+        turn, rim, far = self.turn, self.rim, self.length - self.rim
+        if tau < turn:
+            s, velocity = far + rim * math.sin(math.pi * tau / turn), v * math.cos(math.pi * tau / turn)
+        elif tau < turn + self.cruise:
+            s, velocity = far - v * (tau - turn), -v
+        elif tau < 2.0 * turn + self.cruise:
+            phase = math.pi * (tau - turn - self.cruise) / turn
+            s, velocity = rim - rim * math.sin(phase), -v * math.cos(phase)
+        else:
+            s, velocity = rim + v * (tau - 2.0 * turn - self.cruise), v
+        return min(max(s, 0.0), self.length), velocity
 
 
 class SimulatedHand:
-    """The device interface (``read``, ``write``, ``close``) on a model of a hand.
+    """The device interface (:class:`~rough.render.device.Device`) on a model of a
+    hand stroking a profile.
 
-    The hand strokes along x at a constant ``speed`` while pressing down with
-    ``press``, through its own ``mass`` and ``damping``; the force written is held
-    for one period and the motion over it integrated exactly. ``read()`` returns
-    ``(x, y, buttons)`` (m, m, always 0), ``write(fx, fy)`` applies a force (N) for
-    one period, ``close()`` releases nothing.
+    The hand strokes along x (one way at constant ``speed``, or back and forth as
+    ``stroke`` says) while pressing down with ``press``, through its own ``mass`` and
+    ``damping``; the force written is held for one period and the motion over it
+    integrated exactly. ``read()`` returns ``(x, y, buttons)`` (m, m, always 0),
+    ``write(fx, fy)`` applies a force (N) for one period, ``close()`` releases
+    nothing.
 
     Parameters
     ----------
@@ -45,13 +122,16 @@ class SimulatedHand:
         x; default None, a rigid stroke.
     lateral_damping : float, default 20.0
         N·s/m, with ``lateral_stiffness``.
+    stroke : Stroke, optional
+        The stroke; default one way at ``speed``.
 
     Attributes
     ----------
-    name : str
+    label : str
         ``"sim"``.
-    needs_watchdog : bool
-        False: a simulated hand cannot feel a stuck force.
+    capabilities : Capabilities
+        No watchdog (a simulated hand cannot feel a stuck force), simulated, and the
+        hand's damping as the device's.
     ticks : int
         Periods written so far.
     y, vy : float
@@ -79,8 +159,7 @@ class SimulatedHand:
     (20.0, -3.32)
     """
 
-    name = "sim"
-    needs_watchdog = False
+    label = "sim"
 
     def __init__(
         self,
@@ -93,10 +172,14 @@ class SimulatedHand:
         damping=HAND_DAMPING,
         lateral_stiffness=None,
         lateral_damping=20.0,
+        stroke=None,
     ):
         if not (mass > 0 and damping >= 0 and period > 0):
             raise ValueError("the hand needs a positive mass and period and a non-negative damping")
         self.speed, self.press, self.period = float(speed), float(press), float(period)
+        self.stroke = stroke or Stroke(speed, period)
+        self._along = self.stroke.at
+        self.capabilities = Capabilities(needs_watchdog=False, damping=float(damping), simulated=True)
         self.start_x = float(start_x)
         self.ticks = 0
         self.y, self.vy = float(start_y), 0.0
@@ -108,11 +191,11 @@ class SimulatedHand:
 
     @property
     def velocity(self):
-        return self.speed + self.offset_velocity, self.vy
+        return self.stroke.at(self.ticks)[1] + self.offset_velocity, self.vy
 
     def read(self):
         """``(x, y, buttons)``: metres, metres, no buttons pressed."""
-        return self.start_x + self.speed * self.ticks * self.period + self.offset, self.y, 0
+        return self.start_x + self._along(self.ticks)[0] + self.offset, self.y, 0
 
     def write(self, fx, fy):
         """Apply ``(fx, fy)`` (N) to the hand for one period."""
@@ -120,10 +203,123 @@ class SimulatedHand:
         push = fy - self.press
         self.y, self.vy = p11 * self.y + p12 * self.vy + g1 * push, p21 * self.y + p22 * self.vy + g2 * push
         if self._lateral is not None:
-            p11, p12, p21, p22, g1, g2 = self._lateral
-            e, v = self.offset, self.offset_velocity
-            self.offset, self.offset_velocity = p11 * e + p12 * v + g1 * fx, p21 * e + p22 * v + g2 * fx
+            self.offset, self.offset_velocity = _held(self._lateral, self.offset, self.offset_velocity, fx)
         self.ticks += 1
+
+    def zero(self):
+        """Nothing to zero: the next write sets the force."""
+
+    def emergency_stop(self):
+        """Nothing to stop."""
 
     def close(self):
         """Nothing to release."""
+
+
+class MapHand:
+    """The device interface (:class:`~rough.render.device.Device`) on a model of a
+    hand stroking a map in its plane.
+
+    The hand strokes from ``start`` along the unit vector ``direction`` as
+    ``stroke`` says (one way, or back and forth over a chord of the map); rigidly,
+    unless ``lateral_stiffness`` lets the force push it off its path in both axes.
+    ``read()`` returns ``(x, y, 0)``, the point on the map in metres.
+
+    Parameters
+    ----------
+    stroke : Stroke
+        Where the hand is along its stroke.
+    start : tuple of float
+        Where the stroke starts, ``(x, y)`` metres.
+    direction : tuple of float
+        The stroke's unit vector ``(cos θ, sin θ)``.
+    period : float
+        The servo period, s.
+    mass : float, default 0.15
+        The hand's mass, kg (with ``lateral_stiffness``).
+    damping : float, default 2.0
+        The device's damping as the passivity bound sees it, N·s/m.
+    lateral_stiffness : float, optional
+        N/m, with ``lateral_damping``; default a rigid stroke.
+    lateral_damping : float, default 20.0
+        N·s/m.
+
+    Examples
+    --------
+    >>> import math
+    >>> from rough.render.hand import MapHand, Stroke
+    >>> hand = MapHand(Stroke(0.02, 1e-3), (0.0, 0.0), (math.cos(math.pi / 4), math.sin(math.pi / 4)), 1e-3)
+    >>> for tick in range(10):
+    ...     hand.write(0.0, 0.0)
+    >>> x, y, buttons = hand.read()
+    >>> round(x * 1e6, 3), round(y * 1e6, 3)  # µm: 200 µm along the diagonal
+    (141.421, 141.421)
+    """
+
+    label = "sim"
+
+    def __init__(
+        self,
+        stroke,
+        start,
+        direction,
+        period,
+        mass=HAND_MASS,
+        damping=HAND_DAMPING,
+        lateral_stiffness=None,
+        lateral_damping=20.0,
+    ):
+        if not (mass > 0 and damping >= 0 and period > 0):
+            raise ValueError("the hand needs a positive mass and period and a non-negative damping")
+        self.stroke, self.period = stroke, float(period)
+        self.start, self.direction = tuple(map(float, start)), tuple(map(float, direction))
+        self.capabilities = Capabilities(needs_watchdog=False, damping=float(damping), simulated=True)
+        self.ticks = 0
+        self.offset = [0.0, 0.0, 0.0, 0.0]  # x, vx, y, vy off the path
+        self._lateral = (
+            None if lateral_stiffness is None else zero_order_hold(lateral_stiffness, lateral_damping, mass, period)
+        )
+
+    @property
+    def velocity(self):
+        v = self.stroke.at(self.ticks)[1]
+        return v * self.direction[0] + self.offset[1], v * self.direction[1] + self.offset[3]
+
+    def read(self):
+        """``(x, y, buttons)``: the point on the map, metres; no buttons pressed."""
+        s = self.stroke.at(self.ticks)[0]
+        return (
+            self.start[0] + s * self.direction[0] + self.offset[0],
+            self.start[1] + s * self.direction[1] + self.offset[2],
+            0,
+        )
+
+    def write(self, fx, fy):
+        """Apply ``(fx, fy)`` (N) to the hand for one period."""
+        if self._lateral is not None:
+            o = self.offset
+            o[0], o[1] = _held(self._lateral, o[0], o[1], fx)
+            o[2], o[3] = _held(self._lateral, o[2], o[3], fy)
+        self.ticks += 1
+
+    def zero(self):
+        """Nothing to zero: the next write sets the force."""
+
+    def emergency_stop(self):
+        """Nothing to stop."""
+
+    def close(self):
+        """Nothing to release."""
+
+
+def _held(step, position, velocity, force):
+    """One zero-order-hold step of a spring-damper-mass under ``force``."""
+    p11, p12, p21, p22, g1, g2 = step
+    return p11 * position + p12 * velocity + g1 * force, p21 * position + p22 * velocity + g2 * force
+
+
+def open_device(argument, workspace, max_force, surface=None, **hand):
+    """The :mod:`~rough.render.device` factory's entry: a :class:`MapHand` when
+    ``surface`` is ``"map"`` (``hand`` holds its parameters), else a
+    :class:`SimulatedHand`."""
+    return MapHand(**hand) if surface == "map" else SimulatedHand(**hand)

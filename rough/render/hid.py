@@ -10,13 +10,23 @@ writes one Set Constant Force report per axis. Closing (normal end, Ctrl-C, an e
 the watchdog) writes zero magnitudes, stops and frees the effects, stops all effects
 and disables the actuators; a device that has gone away is reported, not retried.
 
-Positions: the stick's x range maps onto the profile window (``x_span`` metres, from
-the window start), its y range onto ``y_span`` metres centred on ``y_centre``, so a
-centred stick rests above the surface. ``invert`` flips an axis (position and force).
+Positions: a :class:`~rough.render.device.Workspace` maps the stick's travel onto the
+surface; for a profile its x range spans the window and its y range four times the
+height range centred on the top, so a centred stick rests above the surface.
+
+A joystick that a kernel force-feedback driver holds (hid-pidff, hid-universal-pidff
+…: its input device offers force feedback) is refused: the kernel keeps its own table
+of the device's effects, so rough's reset, its effects and its "stop all" on closing
+would clobber whatever a game or SDL uploaded through evdev, and the kernel's later
+updates would land on blocks rough freed. Such a joystick is driven through the
+kernel, with ``--device evdev`` (:mod:`rough.render.evdev`).
 """
 
+import dataclasses
+import os
 import threading
 
+from .device import Capabilities, Workspace
 from .pid import (
     CONSTANT_FORCE,
     DEVICE_GAIN,
@@ -52,17 +62,20 @@ class DeviceGone(PidError):
 
 
 class Joystick:
-    """The render device interface (``read``, ``write``, ``close``,
-    ``emergency_stop``) on a HID PID joystick opened through ``handle`` (a hidapi
-    device object)."""
+    """The render device interface (:class:`~rough.render.device.Device`) on a HID PID
+    joystick opened through ``handle`` (a hidapi device object). The stick's travel
+    lies on the surface as the :class:`~rough.render.device.Workspace` of
+    ``x_start``, ``x_span``, ``y_centre``, ``y_span`` and ``invert`` says."""
 
-    needs_watchdog = True
+    capabilities = Capabilities(axes=2, needs_watchdog=True)
+    velocity = (0.0, 0.0)
 
-    def __init__(self, handle, descriptor, max_force, x_start, x_span, y_centre, y_span, invert=()):
+    def __init__(self, handle, descriptor, max_force, x_start, x_span, y_centre, y_span, invert=(), label="joystick"):
         self.handle, self.pid = handle, PidDescriptor(descriptor)
         self.max_force = float(max_force)
         self.x_start, self.x_span, self.y_centre, self.y_span = x_start, x_span, y_centre, y_span
-        self.x_sign, self.y_sign = (-1 if "x" in invert else 1), (-1 if "y" in invert else 1)
+        self.workspace, self.label = Workspace(x_start, x_span, y_centre, y_span, tuple(invert)), label
+        self.x_sign, self.y_sign = self.workspace.signs
         self._lock = threading.Lock()
         self._stopped = False
         self._closed = False
@@ -83,12 +96,8 @@ class Joystick:
             position = self.pid.position(bytes(report))
             if position is not None:
                 self._state = position
-        fx, fy, buttons = self._state
-        if self.x_sign < 0:
-            fx = 1.0 - fx
-        if self.y_sign < 0:
-            fy = 1.0 - fy
-        return self.x_start + fx * self.x_span, self.y_centre + (fy - 0.5) * self.y_span, buttons
+        u, v, buttons = self._state
+        return *self.workspace.position(u, v), buttons
 
     def write(self, fx, fy):
         """Stream the force ``(fx, fy)`` (N; clamped to the device maximum)."""
@@ -100,6 +109,10 @@ class Joystick:
                 self._send(
                     self.pid.constant, {EFFECT_BLOCK_INDEX: block, MAGNITUDE: field.scale(force / self.max_force)}
                 )
+
+    def zero(self):
+        """Stream zero force, the effects left playing."""
+        self.write(0.0, 0.0)
 
     def emergency_stop(self):
         """Zero the force and stop the effects now (from any thread); later writes are ignored."""
@@ -230,7 +243,41 @@ def _array(report):
     return report.fields[_array_usage(report)]
 
 
-def find_joystick(spec="hid"):
+def kernel_force_feedback(hidraw_path, sysfs="/sys"):
+    """The kernel's hold on a hidraw device's force feedback: ``(driver, event node)``
+    when an input device of the same HID device offers force feedback (a kernel
+    driver such as hid-pidff drives its effects), else None.
+
+    Parameters
+    ----------
+    hidraw_path : bytes or str
+        The hidraw node, e.g. ``b"/dev/hidraw3"``.
+    sysfs : str, default "/sys"
+        Where sysfs is mounted.
+
+    Examples
+    --------
+    >>> from rough.render.hid import kernel_force_feedback
+    >>> kernel_force_feedback(b"/dev/hidraw-none", sysfs="/nonexistent") is None
+    True
+    """
+    name = os.path.basename(os.fsdecode(hidraw_path))
+    device = os.path.realpath(os.path.join(sysfs, "class", "hidraw", name, "device"))
+    inputs = os.path.join(device, "input")
+    for entry in sorted(os.listdir(inputs)) if os.path.isdir(inputs) else ():
+        try:
+            with open(os.path.join(inputs, entry, "capabilities", "ff")) as bits:
+                offered = int(bits.read().replace(" ", "") or "0", 16)
+        except (OSError, ValueError):
+            continue
+        if offered:
+            driver = os.path.basename(os.path.realpath(os.path.join(device, "driver")))
+            events = [e for e in sorted(os.listdir(os.path.join(inputs, entry))) if e.startswith("event")]
+            return driver, "/dev/input/" + events[0] if events else None
+    return None
+
+
+def find_joystick(spec="hid", sysfs="/sys"):
     """Open a force-feedback joystick through hidapi's hidraw backend.
 
     The first hidraw device whose report descriptor offers the HID PID (force
@@ -255,8 +302,10 @@ def find_joystick(spec="hid"):
     ------
     rough.RoughError
         A ``PidError`` (exit status 1) for a malformed ``spec``, when no HID device
-        speaks HID PID, or when a candidate could not be opened (with the hidraw
-        permissions as a hint).
+        speaks HID PID, when a candidate could not be opened (with the hidraw
+        permissions as a hint), or when a kernel force-feedback driver holds the
+        joystick (:func:`kernel_force_feedback`; the message names the evdev node to
+        use instead).
 
     See Also
     --------
@@ -293,8 +342,12 @@ def find_joystick(spec="hid"):
                 f"--device {spec!r}: write hid or hid:VID:PID with hexadecimal IDs, e.g. hid:1209:0001"
             ) from None
     candidates = [d for d in hidraw.enumerate() if wanted is None or (d["vendor_id"], d["product_id"]) == wanted]
-    refused = []
+    refused, held = [], []
     for info in candidates:
+        kernel = kernel_force_feedback(info["path"], sysfs)
+        if kernel is not None:
+            held.append(kernel)
+            continue
         handle = hidraw.device()
         try:
             handle.open_path(info["path"])
@@ -306,6 +359,12 @@ def find_joystick(spec="hid"):
             label = f"{info.get('product_string') or 'joystick'} ({info['vendor_id']:04x}:{info['product_id']:04x})"
             return handle, descriptor, label
         handle.close()
+    if held:
+        driver, node = held[0]
+        raise PidError(
+            f"the kernel's force-feedback driver ({driver}) holds the joystick, and rough writing to it over hidraw "
+            f"would clobber the kernel's effects: use --device evdev{':' + node if node else ''} instead"
+        )
     if refused:
         raise PidError(
             f"no force-feedback joystick could be opened: {'; '.join(refused)} (check the hidraw permissions)"
@@ -317,3 +376,13 @@ def find_joystick(spec="hid"):
     )
     target = "" if wanted is None else f" with ID {wanted[0]:04x}:{wanted[1]:04x}"
     raise PidError(f"no force-feedback joystick found: {what}{target}")
+
+
+def open_device(argument, workspace, max_force, **options):
+    """The :mod:`~rough.render.device` factory's entry: the joystick ``hid[:argument]``."""
+    handle, descriptor, label = find_joystick("hid" if argument is None else f"hid:{argument}")
+    try:
+        return Joystick(handle, descriptor, max_force, *dataclasses.astuple(workspace), label=label)
+    except BaseException:
+        handle.close()
+        raise

@@ -33,9 +33,9 @@ import numpy as np
 
 from ..errors import InputError, RoughError
 from .contact import MAX_FORCE, clamp
+from .track import TRACE_FIELDS
 
 SPIN = 2e-4  # s before each deadline spent spinning instead of sleeping
-TRACE_FIELDS = ("t", "x", "y_i", "h", "F_x", "F_y", "contact")
 TICK_BYTES = 8 * (len(TRACE_FIELDS) + 2)  # a trace row, and a real-time tick's start and deadline
 TRACE_LIMIT = 512 * 2**20  # bytes a run's trace may take: 7.4 million ticks, 2 hours at 1 kHz
 MAX_TICKS = TRACE_LIMIT // TICK_BYTES
@@ -124,7 +124,9 @@ class Run:
         A structured array, one row per tick, with the fields of ``TRACE_FIELDS``:
         ``t`` (s), ``x`` (stylus position, m), ``y_i`` (hand height, m), ``h`` (the
         surface under the stylus, m; NaN where there is no surface), ``F_x``,
-        ``F_y`` (the force written, N) and ``contact`` (bool).
+        ``F_y`` (the force written, N) and ``contact`` (bool). On a map the fields
+        are ``MAP_TRACE_FIELDS``: ``y`` (the point's y on the map, m) replaces
+        ``y_i``, and ``F_x``, ``F_y`` lie in the map's plane.
     ticks : int
         Ticks run.
     wall_time : float
@@ -150,6 +152,8 @@ class Run:
         ``"unpaced"``, ``"normal priority"`` or ``"SCHED_FIFO N"``.
     answer : object
         What ``until`` returned to end the run, or None.
+    model : object
+        The contact model (or gradient field) the run was rendered with.
 
     Notes
     -----
@@ -182,6 +186,7 @@ class Run:
     device: str = "sim"
     scheduling: str = "unpaced"
     answer: object = None
+    model: object = None
 
     def timing(self):
         """Achieved rate (Hz), period jitter p50/p99/max (s), missed deadlines and the
@@ -243,13 +248,12 @@ def run(device, tracks, model, friction=None, settings=None, until=None):
 
     Parameters
     ----------
-    device : object
-        A device with ``read()`` → ``(x m, y m, buttons)``, ``write(fx, fy)`` (N) and
-        ``close()``: a :class:`~rough.render.hand.SimulatedHand` or a joystick.
-    tracks : list of Track
+    device : Device
+        A :class:`~rough.render.device.Device`: a simulated hand or a joystick.
+    tracks : list of Track or list of MapTrack
         One or two tracks; the trigger (button 1) switches between two.
-    model : QuasiStatic or DynamicStylus
-        The contact model; it starts afresh.
+    model : QuasiStatic, DynamicStylus or GradientField
+        The contact model (on a map, the gradient field); it starts afresh.
     friction : object, optional
         A friction model from :func:`parse_friction` (it starts afresh); default none.
     settings : Settings, optional
@@ -312,7 +316,7 @@ def run(device, tracks, model, friction=None, settings=None, until=None):
     if friction is not None:
         friction.reset()
     watchdog = None
-    if settings.realtime and getattr(device, "needs_watchdog", False):
+    if settings.realtime and device.capabilities.needs_watchdog:
         watchdog = _Watchdog(device, settings.watchdog)
     collector = gc.isenabled()
     gc.disable()
@@ -356,6 +360,8 @@ def _raise_priority(priority):
 class _Loop:
     def __init__(self, device, tracks, model, friction, settings, watchdog, until):
         self.device, self.tracks, self.model, self.friction = device, list(tracks), model, friction
+        self.fields = self.tracks[0].fields
+        self.feelings = [track.feel(model, friction, settings.period) for track in self.tracks]
         self.until, self.answer = until, None
         self.settings, self.watchdog = settings, watchdog
         self.rows, self.starts, self.deadlines = array.array("d"), array.array("d"), array.array("d")
@@ -370,14 +376,13 @@ class _Loop:
         total = planned_ticks(s) or MAX_TICKS
         ramp_ticks = s.ramp * s.rate
         alpha = 1.0 - math.exp(-2.0 * math.pi * s.velocity_cutoff * period)
-        read, write, step = self.device.read, self.device.write, self.model.step
-        friction = self.friction.force if self.friction is not None else None
+        read, write = self.device.read, self.device.write
         record = self.rows.extend
         watchdog, until = self.watchdog, self.until
         track = 0
-        at = self.tracks[track].at
+        feel = self.feelings[track]
         x_last, y_last, buttons = read()
-        vx, vy = getattr(self.device, "velocity", (0.0, 0.0))
+        vx, vy = self.device.velocity
         x_last, y_last, ax, pressed = x_last - vx * period, y_last - vy * period, 0.0, buttons & 1
         clock, sleep = time.perf_counter, time.sleep
         begin = clock()
@@ -417,18 +422,11 @@ class _Loop:
                 x_last, y_last = x, y
                 if buttons & 1 and not pressed and len(self.tracks) > 1:
                     track = 1 - track
-                    at = self.tracks[track].at
+                    feel = self.feelings[track]
                     self.model.reset()
                     self.switches += 1
                 pressed = buttons & 1
-                h, slope, curvature = at(x)
-                fx, fy, contact = step(x, h, slope, curvature, y, vx, vy, ax)
-                if friction is not None:
-                    tangential = friction(contact, x, vx, period)
-                    if tangential:
-                        norm = 1.0 / math.sqrt(1.0 + slope * slope)
-                        fx += tangential * norm
-                        fy += tangential * slope * norm
+                h, fx, fy, contact = feel(x, y, vx, vy, ax)
                 fx, fy = clamp(fx, fy, limit)
                 if k < ramp_ticks:
                     fx, fy = fx * k / ramp_ticks, fy * k / ramp_ticks
@@ -442,11 +440,10 @@ class _Loop:
             self.wall_time = clock() - begin
 
     def result(self):
-        columns = np.frombuffer(self.rows, dtype=np.float64).reshape(-1, len(TRACE_FIELDS))
-        trace = np.empty(
-            len(columns), dtype=[(name, np.float64) for name in TRACE_FIELDS[:-1]] + [("contact", np.bool_)]
-        )
-        for index, name in enumerate(TRACE_FIELDS):
+        fields = self.fields
+        columns = np.frombuffer(self.rows, dtype=np.float64).reshape(-1, len(fields))
+        trace = np.empty(len(columns), dtype=[(name, np.float64) for name in fields[:-1]] + [("contact", np.bool_)])
+        for index, name in enumerate(fields):
             trace[name] = columns[:, index]
         trace["h"][~np.isfinite(trace["h"])] = np.nan
         starts = np.frombuffer(self.starts, dtype=np.float64) if self.starts else None
@@ -463,6 +460,8 @@ class _Loop:
             self.missed,
             self.switches,
             self.ended_by,
+            device=self.device.label,
             scheduling=self.scheduling,
             answer=self.answer,
+            model=self.model,
         )
