@@ -49,7 +49,7 @@ COMMANDS = {
     "rose": ["rose", "--json"],
     "render": ["render", "--json", "--duration", "50ms"],
 }
-MAP_ONLY, PROFILE_ONLY = {"rose"}, {"render"}
+MAP_ONLY, PROFILE_ONLY = {"rose"}, set()
 # null by design: no noise floor found, no roll-off asked for, no hint needed
 NOT_APPLICABLE = {"noise_rms", "noise_crossover", "rolloff_wavelength", "hint"}
 # a bound is a result: its standard errors are null (the warning says "bound")
