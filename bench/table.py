@@ -27,14 +27,19 @@ def table(rows):
     ]
     for row in rows:
         peak = f"{row['peak']:.1f}×" if row.get("peak") is not None else ""
-        cpu = f"{row['cpu_median']:.2f}×" if row.get("cpu_median") is not None else ""
+        cpu = _ratio(row["cpu_median"]) if row.get("cpu_median") is not None else ""
         baseline = f"{row['baseline']} ({_seconds(row['baseline_seconds'])})"
-        ratios = f"{row['wall_min']:.2f}× / {row['wall_median']:.2f}×"
+        ratios = f"{_ratio(row['wall_min'])} / {_ratio(row['wall_median'])}"
         lines.append(
             f"| {row['name'].strip()} | {_seconds(row['seconds'])} | {baseline} | {ratios} | {cpu} | {peak} "
             f"| {row.get('goal') or ''} |"
         )
     return "\n".join(lines)
+
+
+def _ratio(value):
+    """Three significant digits, so that a small ratio (a share of real time) still shows."""
+    return f"{value:.3g}×"
 
 
 def _seconds(value):

@@ -605,3 +605,47 @@ def test_the_stick_spans_the_tracks_unless_both_spans_are_given(monkeypatch, sti
     assert label == "virtual" and (joystick.x_span, joystick.y_span) == pytest.approx(expected)
     assert joystick.y_centre == pytest.approx(1e-3)
     joystick.close()
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    stiffness=st.one_of(st.just(0.0), st.floats(1e-2, 1e4)),
+    damping=st.floats(0.0, 100.0),
+    mass=st.floats(1e-3, 1.0),
+    period=st.floats(1e-5, 1e-2),
+)
+def test_the_zero_order_hold_is_scipys_matrix_exponential(stiffness, damping, mass, period):
+    """The pure-Python exponential (scipy's expm wakes BLAS threads that spin for 0.1 s)
+    agrees with scipy.linalg.expm to 1e-11 of each column's largest entry."""
+    from scipy.linalg import expm
+
+    from rough.render.contact import zero_order_hold
+
+    augmented = np.array([[0, 1, 0], [-stiffness / mass, -damping / mass, 1 / mass], [0, 0, 0]]) * period
+    expected = expm(augmented)[:2]
+    p11, p12, p21, p22, g1, g2 = zero_order_hold(stiffness, damping, mass, period)
+    got = np.array([[p11, p12, g1], [p21, p22, g2]])
+    scale = np.abs(expected).max(axis=0)
+    assert (np.abs(got - expected).max(axis=0) <= 1e-11 * scale).all()
+
+
+def test_the_zero_order_hold_of_a_free_mass_is_exact():
+    from rough.render.contact import zero_order_hold
+
+    p11, p12, p21, p22, g1, g2 = zero_order_hold(0.0, 0.0, 0.5, 0.01)
+    assert (p11, p12, p21, p22) == (1.0, 0.01, 0.0, 1.0)
+    assert g1 == pytest.approx(0.01**2 / (2 * 0.5), rel=1e-15) and g2 == pytest.approx(0.01 / 0.5, rel=1e-15)
+
+
+def test_a_simulated_run_wakes_no_blas_threads(monkeypatch):
+    """scipy's expm (BLAS) leaves OpenBLAS threads spinning on another core for about
+    0.1 s, which doubled the CPU time of a short simulated run: the hand and stylus
+    steps are computed without it."""
+    import scipy.linalg
+
+    def refused(*args, **kwargs):
+        raise AssertionError("scipy.linalg.expm called")
+
+    monkeypatch.setattr(scipy.linalg, "expm", refused)
+    for model in (QuasiStatic(), DynamicStylus()):
+        assert simulate(FLAT, 0.02, model, lateral_stiffness=500.0).ticks == 500

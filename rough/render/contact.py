@@ -22,8 +22,6 @@ velocity, ``ax`` its horizontal acceleration).
 
 import math
 
-import numpy as np
-
 STIFFNESS = 1280.0  # N/m: the paper's 1.28 N/mm
 STYLUS_MASS = 1.85e-3  # kg: the slides' "1.85e-6" read in N·s²/mm (docs/math.rst §5.3)
 STYLUS_DAMPING = 0.046  # N·s/m: the slides' 4.6e-5 N/(mm/s)
@@ -242,16 +240,58 @@ class GradientField:
 def zero_order_hold(stiffness, damping, mass, period):
     """The exact step of ``m ẍ = F - k x - b ẋ`` over ``period`` with F held constant:
     ``(Φ11, Φ12, Φ21, Φ22, Γ1, Γ2)`` such that ``x' = Φ11 x + Φ12 v + Γ1 F`` and
-    ``v' = Φ21 x + Φ22 v + Γ2 F``."""
-    from scipy.linalg import expm
+    ``v' = Φ21 x + Φ22 v + Γ2 F``: the exponential of the augmented matrix
+    ``[[0, 1, 0], [-k/m, -b/m, 1/m], [0, 0, 0]] × period``.
 
-    augmented = np.zeros((3, 3))
-    augmented[0, 1] = 1.0
-    augmented[1, 0] = -stiffness / mass
-    augmented[1, 1] = -damping / mass
-    augmented[1, 2] = 1.0 / mass
-    step = expm(augmented * period)
-    return tuple(float(v) for v in (step[0, 0], step[0, 1], step[1, 0], step[1, 1], step[0, 2], step[1, 2]))
+    Examples
+    --------
+    A free mass (k = b = 0) under a held force moves by F T²/(2m):
+
+    >>> from rough.render.contact import zero_order_hold
+    >>> p11, p12, p21, p22, g1, g2 = zero_order_hold(0.0, 0.0, 2.0, 0.1)
+    >>> (p11, p12, p21, p22), round(g1, 15), round(g2, 15)
+    ((1.0, 0.1, 0.0, 1.0), 0.0025, 0.05)
+    """
+    # in the balanced state (x, v/ω, F/(m ω²)), ω² = k/m (or 1/T² for a free mass), the
+    # entries are at most ωT and bT/m: no more squarings than the motion needs
+    omega = math.sqrt(stiffness / mass) if stiffness > 0 else 1.0 / period
+    turn = omega * period
+    spring = stiffness / mass * period / omega
+    step = _exponential([[0.0, turn, 0.0], [-spring, -damping / mass * period, turn], [0.0] * 3])
+    to_state = (1.0, omega, mass * omega * omega)  # x, v, F from the balanced state
+    return (
+        step[0][0],
+        step[0][1] / to_state[1],
+        step[1][0] * to_state[1],
+        step[1][1],
+        step[0][2] / to_state[2],
+        step[1][2] * to_state[1] / to_state[2],
+    )
+
+
+def _exponential(matrix):
+    """The exponential of a small square matrix (lists of floats): a Taylor series of
+    the matrix scaled to a norm of at most 1/2 (its remainder after 20 terms is below
+    1e-24), then squared back. Pure Python: scipy's expm wakes the BLAS threads, which
+    then spin on another core for about 0.1 s, doubling the CPU time of a short
+    simulated run."""
+    size = len(matrix)
+    norm = max(sum(abs(v) for v in row) for row in matrix)
+    squarings = max(0, math.ceil(math.log2(norm / 0.5))) if norm > 0.5 else 0
+    scaled = [[v / 2.0**squarings for v in row] for row in matrix]
+    result = [[float(i == j) for j in range(size)] for i in range(size)]
+    term = [row[:] for row in result]
+    for k in range(1, 21):
+        term = [[v / k for v in row] for row in _product(term, scaled)]
+        result = [[r + t for r, t in zip(rows, terms)] for rows, terms in zip(result, term)]
+    for _ in range(squarings):
+        result = _product(result, result)
+    return result
+
+
+def _product(a, b):
+    columns = list(zip(*b))
+    return [[math.fsum(x * y for x, y in zip(row, column)) for column in columns] for row in a]
 
 
 def clamp(fx, fy, limit):
