@@ -240,6 +240,13 @@ def drop(model, rate=500.0, damping=0.5, mass=0.15, press=0.2, height=1e-4, dura
     return 0.5 * mass * v**2 + press * y + np.array(probe.energies), result
 
 
+def largest_gain(model, rate, damping, mass, press, height):
+    """The largest energy gain of one tick in a 0.3 s drop, as a share of the energy's
+    scale (its largest magnitude, plus the press over 2 mm, plus 1 nJ)."""
+    energy, _ = drop(model, rate=rate, damping=damping, mass=mass, press=press, height=height, duration=0.3)
+    return np.diff(energy).max() / (np.abs(energy).max() + press * 2e-3 + 1e-9)
+
+
 RATE, HAND_DAMPING = 500.0, 0.5  # Hz, N·s/m: bound 2b/T = 500 N/m
 STIFF = 10 * passivity_bound(RATE, HAND_DAMPING)  # 5 N/mm, ten times the bound
 TOLERANCE = 1e-12  # J: rounding, against energies of 2e-5 J and more
@@ -294,9 +301,7 @@ def test_random_drops_through_a_coupling_under_the_bound_never_gain_energy(
     bc = damper_share * damping
     kc = share * passivity_bound(rate, damping, bc)
     coupled = VirtualCoupling(QuasiStatic(wall * passivity_bound(rate, damping)), kc, bc, 1.0 / rate)
-    energy, _ = drop(coupled, rate=rate, damping=damping, mass=mass, press=press, height=height, duration=0.3)
-    scale = np.abs(energy).max() + press * 2e-3 + 1e-9
-    assert np.diff(energy).max() <= 1e-10 * scale
+    assert largest_gain(coupled, rate, damping, mass, press, height) <= 1e-10
 
 
 def test_simulate_settles_the_hand_on_the_coupled_wall_at_its_press():
@@ -321,6 +326,4 @@ def test_the_same_check_flags_random_couplings_over_the_bound(over, damping, rat
     """The tolerance above is tight enough to see a coupling 1.5 to 4 times over the bound."""
     bound = passivity_bound(rate, damping)
     coupled = VirtualCoupling(QuasiStatic(50 * bound), over * bound, 0.0, 1.0 / rate)
-    energy, _ = drop(coupled, rate=rate, damping=damping, mass=mass, press=press, height=height, duration=0.3)
-    scale = np.abs(energy).max() + press * 2e-3 + 1e-9
-    assert np.diff(energy).max() > 1e-10 * scale
+    assert largest_gain(coupled, rate, damping, mass, press, height) > 1e-10

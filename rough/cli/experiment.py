@@ -208,15 +208,14 @@ def _joystick_session(study, subject, haptics, contact, friction):
     from .. import read
     from ..experiment.session import Keyboard, joystick_presenter, run_session
     from ..render import Track
-    from ..render.session import fitted_model, open_joystick
+    from ..render.hand import PRESS
+    from ..render.session import open_joystick
 
     tracks = {name: Track.from_surface(read(study.surface_path(name))) for name in study.surfaces}
     joystick, _ = open_joystick(
         haptics.device, list(tracks.values()), haptics.max_force, haptics.stick_span, haptics.invert
     )
-    model = fitted_model(contact, joystick)
-    if model is contact:
-        haptics.warn_if_unstable()
+    model = haptics.device_model(contact, PRESS, joystick)
     keyboard = Keyboard()
     try:
         present = joystick_presenter(tracks, joystick, model, friction, haptics.settings(), keyboard)

@@ -109,6 +109,17 @@ class Haptics:
             )
         return GradientField(load)
 
+    def device_model(self, contact, load, device):
+        """``contact`` as the open ``device`` renders it (a wheel feels a profile's
+        lateral force alone, with the normal load ``load``, N), checked against the
+        passivity bound when it is a contact model."""
+        from ..render.session import fitted_model
+
+        model = fitted_model(contact, device, load)
+        if model is contact and hasattr(contact, "stiffness"):
+            self.warn_if_unstable()
+        return model
+
     def warn_if_unstable(self, damping=None):
         """Log one warning when the contact stiffness exceeds the passivity bound at
         this rate for a device of damping ``damping`` (N·s/m; default

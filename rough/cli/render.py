@@ -149,7 +149,7 @@ def render(
             run_stick(
                 haptics.device,
                 tracks,
-                functools.partial(_model_for, haptics, contact, press),
+                functools.partial(haptics.device_model, contact, press),
                 friction,
                 settings,
                 haptics.stick_span,
@@ -158,17 +158,6 @@ def render(
         ]
     _outputs(runs, trace, plot, shown(inputs[0]))
     return Report(*summary_rows(runs, haptics.friction)) if report else None
-
-
-def _model_for(haptics, contact, press, device):
-    """The model for ``device`` once open (a wheel feels a profile's lateral force
-    alone), checked against the passivity bound when it is a contact model."""
-    from ..render.session import fitted_model
-
-    model = fitted_model(contact, device, press)
-    if model is contact and hasattr(contact, "stiffness"):
-        haptics.warn_if_unstable()
-    return model
 
 
 def _track(surface, window, fill, tip, row):

@@ -132,6 +132,22 @@ class Workspace:
         return self.x_start + u * self.x_span, self.y_centre + (v - 0.5) * self.y_span
 
 
+class StreamedForce:
+    """``zero`` and ``emergency_stop`` for a joystick that streams its force under
+    ``self._lock``, ignores writes once ``self._stopped`` is set, and stops its effects
+    with ``self._silence()``: the HID and evdev backends."""
+
+    def zero(self):
+        """Stream zero force, the effects left playing."""
+        self.write(0.0, 0.0)
+
+    def emergency_stop(self):
+        """Zero the force and stop the effects now (from any thread); later writes are ignored."""
+        with self._lock:
+            self._stopped = True
+            self._silence()
+
+
 class HeldOpen:
     """A device whose ``close`` only zeroes the force, so that one device serves many
     runs (the experiment's trials); close the device itself at the end."""

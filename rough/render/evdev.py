@@ -39,7 +39,7 @@ import os
 import struct
 import threading
 
-from .device import Capabilities, DeviceError
+from .device import Capabilities, DeviceError, StreamedForce
 
 FULL_LEVEL = 0x7FFF  # the s16 level of the device's full force
 FULL_GAIN = 0xFFFF
@@ -161,7 +161,7 @@ def constant_effect(direction, level, effect_id=-1):
 # -- the device -------------------------------------------------------------------------------
 
 
-class EvdevDevice:
+class EvdevDevice(StreamedForce):
     """The render device interface (:class:`~rough.render.device.Device`) on an open
     evdev node ``device`` (a python-evdev ``InputDevice``, opened for reading and
     writing), with the stick's travel on the surface given by ``workspace`` and
@@ -226,16 +226,6 @@ class EvdevDevice:
             for effect, (direction, value) in zip(self.effects, targets):
                 if (effect.direction, effect.u.ff_constant_effect.level) != (direction, value):
                     self._update(effect, direction, value)
-
-    def zero(self):
-        """Zero the force, the effects left playing."""
-        self.write(0.0, 0.0)
-
-    def emergency_stop(self):
-        """Zero the force and stop the effects now (from any thread); later writes are ignored."""
-        with self._lock:
-            self._stopped = True
-            self._silence()
 
     def close(self):
         """Zero the force, stop and erase every effect, close the node; safe to call twice."""

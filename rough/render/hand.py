@@ -92,7 +92,34 @@ class Stroke:
         return min(max(s, 0.0), self.length), velocity
 
 
-class SimulatedHand:
+class _Hand:
+    """What both simulated hands share: the device interface's bookkeeping (no
+    watchdog, nothing to zero, stop or release), the checks of the hand's mass, damping
+    and period, and the lateral spring-damper that lets forces push it off its path."""
+
+    label = "sim"
+
+    def __init__(self, stroke, period, mass, damping, lateral_stiffness, lateral_damping):
+        if not (mass > 0 and damping >= 0 and period > 0):
+            raise ValueError("the hand needs a positive mass and period and a non-negative damping")
+        self.stroke, self.period = stroke, float(period)
+        self.capabilities = Capabilities(needs_watchdog=False, damping=float(damping), simulated=True)
+        self.ticks = 0
+        self._lateral = (
+            None if lateral_stiffness is None else zero_order_hold(lateral_stiffness, lateral_damping, mass, period)
+        )
+
+    def zero(self):
+        """Nothing to zero: the next write sets the force."""
+
+    def emergency_stop(self):
+        """Nothing to stop."""
+
+    def close(self):
+        """Nothing to release."""
+
+
+class SimulatedHand(_Hand):
     """The device interface (:class:`~rough.render.device.Device`) on a model of a
     hand stroking a profile.
 
@@ -159,8 +186,6 @@ class SimulatedHand:
     (20.0, -3.32)
     """
 
-    label = "sim"
-
     def __init__(
         self,
         speed,
@@ -174,20 +199,12 @@ class SimulatedHand:
         lateral_damping=20.0,
         stroke=None,
     ):
-        if not (mass > 0 and damping >= 0 and period > 0):
-            raise ValueError("the hand needs a positive mass and period and a non-negative damping")
-        self.speed, self.press, self.period = float(speed), float(press), float(period)
-        self.stroke = stroke or Stroke(speed, period)
-        self._along = self.stroke.at
-        self.capabilities = Capabilities(needs_watchdog=False, damping=float(damping), simulated=True)
+        super().__init__(stroke or Stroke(speed, period), period, mass, damping, lateral_stiffness, lateral_damping)
+        self.speed, self.press = float(speed), float(press)
         self.start_x = float(start_x)
-        self.ticks = 0
         self.y, self.vy = float(start_y), 0.0
         self.offset, self.offset_velocity = 0.0, 0.0
         self._vertical = zero_order_hold(0.0, damping, mass, period)
-        self._lateral = (
-            None if lateral_stiffness is None else zero_order_hold(lateral_stiffness, lateral_damping, mass, period)
-        )
 
     @property
     def velocity(self):
@@ -195,7 +212,7 @@ class SimulatedHand:
 
     def read(self):
         """``(x, y, buttons)``: metres, metres, no buttons pressed."""
-        return self.start_x + self._along(self.ticks)[0] + self.offset, self.y, 0
+        return self.start_x + self.stroke.at(self.ticks)[0] + self.offset, self.y, 0
 
     def write(self, fx, fy):
         """Apply ``(fx, fy)`` (N) to the hand for one period."""
@@ -206,17 +223,8 @@ class SimulatedHand:
             self.offset, self.offset_velocity = _held(self._lateral, self.offset, self.offset_velocity, fx)
         self.ticks += 1
 
-    def zero(self):
-        """Nothing to zero: the next write sets the force."""
 
-    def emergency_stop(self):
-        """Nothing to stop."""
-
-    def close(self):
-        """Nothing to release."""
-
-
-class MapHand:
+class MapHand(_Hand):
     """The device interface (:class:`~rough.render.device.Device`) on a model of a
     hand stroking a map in its plane.
 
@@ -256,8 +264,6 @@ class MapHand:
     (141.421, 141.421)
     """
 
-    label = "sim"
-
     def __init__(
         self,
         stroke,
@@ -269,16 +275,9 @@ class MapHand:
         lateral_stiffness=None,
         lateral_damping=20.0,
     ):
-        if not (mass > 0 and damping >= 0 and period > 0):
-            raise ValueError("the hand needs a positive mass and period and a non-negative damping")
-        self.stroke, self.period = stroke, float(period)
+        super().__init__(stroke, period, mass, damping, lateral_stiffness, lateral_damping)
         self.start, self.direction = tuple(map(float, start)), tuple(map(float, direction))
-        self.capabilities = Capabilities(needs_watchdog=False, damping=float(damping), simulated=True)
-        self.ticks = 0
         self.offset = [0.0, 0.0, 0.0, 0.0]  # x, vx, y, vy off the path
-        self._lateral = (
-            None if lateral_stiffness is None else zero_order_hold(lateral_stiffness, lateral_damping, mass, period)
-        )
 
     @property
     def velocity(self):
@@ -301,15 +300,6 @@ class MapHand:
             o[0], o[1] = _held(self._lateral, o[0], o[1], fx)
             o[2], o[3] = _held(self._lateral, o[2], o[3], fy)
         self.ticks += 1
-
-    def zero(self):
-        """Nothing to zero: the next write sets the force."""
-
-    def emergency_stop(self):
-        """Nothing to stop."""
-
-    def close(self):
-        """Nothing to release."""
 
 
 def _held(step, position, velocity, force):

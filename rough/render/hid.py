@@ -26,7 +26,7 @@ import dataclasses
 import os
 import threading
 
-from .device import Capabilities, Workspace
+from .device import Capabilities, StreamedForce, Workspace
 from .pid import (
     CONSTANT_FORCE,
     DEVICE_GAIN,
@@ -61,7 +61,7 @@ class DeviceGone(PidError):
     """The joystick stopped answering (unplugged, or its driver went away)."""
 
 
-class Joystick:
+class Joystick(StreamedForce):
     """The render device interface (:class:`~rough.render.device.Device`) on a HID PID
     joystick opened through ``handle`` (a hidapi device object). The stick's travel
     lies on the surface as the :class:`~rough.render.device.Workspace` of
@@ -109,16 +109,6 @@ class Joystick:
                 self._send(
                     self.pid.constant, {EFFECT_BLOCK_INDEX: block, MAGNITUDE: field.scale(force / self.max_force)}
                 )
-
-    def zero(self):
-        """Stream zero force, the effects left playing."""
-        self.write(0.0, 0.0)
-
-    def emergency_stop(self):
-        """Zero the force and stop the effects now (from any thread); later writes are ignored."""
-        with self._lock:
-            self._stopped = True
-            self._silence()
 
     def close(self):
         """Zero the force, stop and free the effects, disable the actuators, close the handle."""

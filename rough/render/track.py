@@ -279,11 +279,6 @@ class MapTrack:
         centre = ((x0 + x1) / 2, (y0 + y1) / 2)
         return (centre[0] - half * unit[0], centre[1] - half * unit[1]), unit, 2 * half
 
-    @property
-    def length(self):
-        """The map's extent along x, metres."""
-        return self.extent[1] - self.extent[0]
-
     def feel(self, field, friction, period):
         """The force on the hand at each tick: a function ``(x, y, vx, vy, ax)`` →
         ``(h, F_x, F_y, contact)`` at the point ``(x, y)``: the gradient ``field``'s
