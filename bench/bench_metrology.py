@@ -70,6 +70,7 @@ def main():
         goal="≤ 8×, memory ≤ 4×",
     )
     half = rough.Surface(heights[: n // 2, : n // 2].copy(), (1e-6, 1e-6))
+    watershed(half)  # numba compiles the passes (or loads them from its cache) once per process
     compare(
         f"features {n // 2}²: watershed, Spd…Shv",
         lambda: watershed(half),

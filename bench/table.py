@@ -4,7 +4,8 @@
 Run:  python bench/table.py build/bench.jsonl README.md
 
 Replaces what lies between the README's ``<!-- bench:start -->`` and
-``<!-- bench:end -->`` lines; prints the table when no README is given.
+``<!-- bench:end -->`` lines; prints the table when no README is given. A measure
+given twice (a benchmark run again, appended) keeps its first place and its last figures.
 """
 
 import json
@@ -53,7 +54,12 @@ def _cores():
 
 
 def main():
-    rows = [json.loads(line) for line in pathlib.Path(sys.argv[1]).read_text().splitlines() if line.strip()]
+    measures = {}  # a later row of the same measure replaces the earlier one, in its place
+    for line in pathlib.Path(sys.argv[1]).read_text().splitlines():
+        if line.strip():
+            row = json.loads(line)
+            measures[row["name"]] = row
+    rows = list(measures.values())
     for row in rows:
         row.setdefault("wall_min", min(row["wall"]))
         row.setdefault("wall_median", statistics.median(row["wall"]))

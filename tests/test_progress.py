@@ -103,6 +103,17 @@ def test_ctrl_c_stops_a_large_synthesis_within_a_second_with_nothing_written(tmp
     assert list(tmp_path.iterdir()) == []
 
 
+def test_ctrl_c_stops_a_segmentation_within_a_second(tmp_path):
+    heights = tmp_path / "rough.npy"
+    rng = np.random.default_rng(7)
+    np.save(heights, np.cumsum(rng.standard_normal((2048, 2048)), axis=1) * 1e-9)  # many basins
+    process = start("-v", "features", "--spacing", "1um", heights)
+    seconds, stderr = interrupt_when(process, "segmenting hills: 2048 × 2048 points by compiled passes", after=0.3)
+    assert process.returncode == 130, stderr
+    assert seconds < 2, f"{seconds:.2f} s of CPU from SIGINT to the exit"
+    assert "Traceback" not in stderr and stderr.rstrip().endswith("rough features: interrupted"), stderr
+
+
 # -- progress bars --------------------------------------------------------------------------------------
 
 

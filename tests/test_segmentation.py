@@ -2,13 +2,17 @@
 (rough.metrology.segmentation)."""
 
 import math
+from unittest import mock
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from scipy import ndimage
 from skimage.segmentation import watershed
 
 from rough import InputError, Surface
+from rough.metrology import segmentation
 from rough.metrology.parameters import centred
 from rough.metrology.segmentation import EDGES, FEATURE, feature_parameters, segment
 
@@ -389,3 +393,132 @@ def test_bad_input(call):
 
 def test_the_edge_choices():
     assert EDGES == ("exclude", "include")
+
+
+# ---------------------------------------------------------------------------------
+# 4. The compiled passes give what scikit-image and the plain definitions give
+
+
+def flooded_and_descended(image):
+    """scikit-image's watershed from the markers of ``segment`` and the steepest descent
+    (None where it does not decide), on ``image`` with NaN at invalid points."""
+    valid = ~np.isnan(image)
+    filled = np.where(valid, image, np.nanmax(image))
+    markers, _ = segmentation._markers(filled, valid)
+    flooded = watershed(filled, markers, connectivity=2, mask=valid)
+    return flooded, segmentation._descend(filled, valid, markers)
+
+
+@st.composite
+def images(draw):
+    """Small maps of float heights (smooth or rough), of a few levels (plateaus and
+    ties), or of both, with or without invalid points."""
+    shape = (draw(st.integers(1, 24)), draw(st.integers(1, 24)))
+    rng = np.random.default_rng(draw(st.integers(0, 2**32 - 1)))
+    image = rng.standard_normal(shape)
+    if draw(st.booleans()) and min(shape) > 1:
+        image = ndimage.gaussian_filter(image, draw(st.floats(0.5, 3.0)))
+    if draw(st.booleans()):
+        image = np.round(image * draw(st.sampled_from([1.0, 3.0, 30.0])))
+    if draw(st.booleans()):
+        image[rng.random(shape) < draw(st.floats(0.0, 0.5))] = np.nan
+    if np.isnan(image).all():
+        image[0, 0] = 1.0
+    return image
+
+
+@settings(max_examples=400, deadline=None)
+@given(images())
+def test_the_descent_is_the_flood_wherever_it_decides(image):
+    flooded, descended = flooded_and_descended(image)
+    assert descended is None or np.array_equal(descended, flooded)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_descent_decides_on_float_heights(seed):
+    image = smoothed_noise((120, 90), seed)
+    image[40:50, 20:35] = np.nan
+    flooded, descended = flooded_and_descended(image)
+    assert descended is not None and np.array_equal(descended, flooded)
+
+
+def test_a_plateau_leaves_it_to_the_flood():
+    image = smoothed_noise((40, 40), 1)
+    image[10:20, 10:20] = image[10:20, 10:20].max()  # a raised plateau, lower on some sides
+    assert flooded_and_descended(image)[1] is None
+    image = np.round(smoothed_noise((40, 40), 1) * 3e6)  # three levels or so: ties everywhere
+    assert flooded_and_descended(image)[1] is None
+
+
+def test_a_point_between_two_basins_at_one_height_leaves_it_to_the_flood():
+    image = np.array([[0.0, 2.0, 3.0, 2.0, 0.0]])  # 3's two lowest neighbours (2, 2) lie in two basins
+    assert flooded_and_descended(image)[1] is None
+    image = np.array([[0.0, 2.0, 3.0, 2.5, 0.0]])
+    flooded, descended = flooded_and_descended(image)
+    assert np.array_equal(descended, flooded) and descended.tolist() == [[1, 1, 1, 2, 2]]
+
+
+def regions_by_hand(filled, labels):
+    """What _regions gives, the slow and obvious way: per label its lowest value and
+    first point with it, highest value, points, whether on the border or next to an
+    invalid point; per two neighbouring labels the lowest pour height."""
+    ny, nx = labels.shape
+    figures, saddles = {}, {}
+    for i in range(ny):
+        for j in range(nx):
+            label = int(labels[i, j])
+            if label:
+                low, pit, high, area, edge = figures.get(label, (math.inf, -1, -math.inf, 0, False))
+                if filled[i, j] < low:
+                    low, pit = filled[i, j], i * nx + j
+                edge = edge or i in (0, ny - 1) or j in (0, nx - 1)
+                figures[label] = (low, pit, max(high, filled[i, j]), area + 1, edge)
+            for di, dj in ((0, 1), (1, -1), (1, 0), (1, 1)):
+                k, m = i + di, j + dj
+                if 0 <= k < ny and 0 <= m < nx and labels[k, m] != label:
+                    other = int(labels[k, m])
+                    if label and other:
+                        key = (label, other)
+                        saddles[key] = min(saddles.get(key, math.inf), max(filled[i, j], filled[k, m]))
+                    else:
+                        touching = label or other
+                        low, pit, high, area, _ = figures.get(touching, (math.inf, -1, -math.inf, 0, False))
+                        figures[touching] = (low, pit, high, area, True)
+    return figures, saddles
+
+
+@settings(max_examples=200, deadline=None)
+@given(images(), st.sampled_from([0, math.inf]))
+def test_the_regions_are_the_plain_definition(image, compiled_from):
+    valid = ~np.isnan(image)
+    filled = np.where(valid, image, np.nanmax(image))
+    labels, count = segmentation._basins(filled, valid)
+    with mock.patch.object(segmentation, "COMPILED_MIN", compiled_from), mock.patch.object(segmentation, "BAND", 7):
+        regions = segmentation._regions(filled, labels, count)
+    figures, saddles = regions_by_hand(filled, labels)
+    assert sorted(figures) == list(range(1, count + 1))
+    for label, (low, pit, high, area, edge) in figures.items():
+        assert (regions["low"][label], regions["pit"][label], regions["high"][label]) == (low, pit, high)
+        assert (regions["area"][label], regions["edge"][label]) == (area, edge)
+    listed = {}
+    for a, b, pour in zip(regions["first"].tolist(), regions["second"].tolist(), regions["pour"].tolist()):
+        listed[a, b] = min(listed.get((a, b), math.inf), pour)
+    assert listed == saddles
+    assert not regions["edge"][0]
+
+
+@pytest.mark.parametrize("index", range(len(MAPS)))
+@pytest.mark.parametrize("kind", ["hills", "dales"])
+def test_the_compiled_passes_give_the_same_motifs(index, kind, monkeypatch):
+    heights = np.repeat(np.repeat(MAPS[index], 3, axis=0), 2, axis=1)  # a larger map with plateaus: floods
+    for image in (MAPS[index], heights + smoothed_noise(heights.shape, index) * 1e-3):
+        surface = Surface(image, DX)
+        monkeypatch.setattr(segmentation, "COMPILED_MIN", 0)
+        monkeypatch.setattr(segmentation, "COMPILED_SADDLES", 0)
+        monkeypatch.setattr(segmentation, "BAND", 37)  # many bands
+        descended = segment(surface, kind, 3.0)
+        monkeypatch.setattr(segmentation, "COMPILED_MIN", math.inf)
+        monkeypatch.setattr(segmentation, "COMPILED_SADDLES", math.inf)
+        flooded = segment(surface, kind, 3.0)
+        assert np.array_equal(descended.labels, flooded.labels)
+        assert repr(descended.motifs) == repr(flooded.motifs)  # NaN fields too

@@ -11,6 +11,7 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
 from rough import Surface
+from rough.compiled import compiled
 from rough.errors import InputError
 from rough.metrology import tip
 from rough.metrology.tip import PRESETS, closing_envelope, tip_profile, traced
@@ -355,7 +356,7 @@ def test_the_sweep_settles_each_crossing_on_the_sums_whatever_the_estimate(radii
         widths = np.isfinite(quadrant).sum(axis=1) - 1
         image, path = np.where(np.isnan(z), -np.inf, z), np.empty_like(z)
         estimates = (radii * radius**2 - rows**2, spacing * grid[0])
-        tip._kernel()(image, quadrant, widths, np.ones(len(rows), dtype=bool), *estimates, 1, 0, len(z), path)
+        compiled(tip._rows)(image, quadrant, widths, np.ones(len(rows), dtype=bool), *estimates, 1, 0, len(z), path)
         path = np.where(np.isnan(z) | ~np.isfinite(path), np.nan, np.fmax(path, z))
         np.testing.assert_array_equal(path, brute_force(z, radius, grid))
 
@@ -420,13 +421,13 @@ def test_ctrl_c_stops_the_workers_after_their_current_chunk(monkeypatch):
     import rough.progress
 
     monkeypatch.setattr(tip, "CHUNK_SECONDS", 1e-7)  # a row a chunk: 400 chunks
-    compiled, calls = tip._kernel(), []
+    kernel, calls = compiled(tip._rows), []
 
     def slow(*args):  # about 10 ms a chunk
         if args[-3] < args[-2]:
             calls.append(args[-3])
             time.sleep(0.01)
-        return compiled(*args)
+        return kernel(*args)
 
     class Interrupted:
         n = 0
@@ -443,7 +444,7 @@ def test_ctrl_c_stops_the_workers_after_their_current_chunk(monkeypatch):
         def update(self, n):
             raise KeyboardInterrupt
 
-    monkeypatch.setattr(tip, "_kernel", lambda: slow)
+    monkeypatch.setattr(tip, "compiled", lambda function: slow)
     monkeypatch.setattr(rough.progress, "progress", Interrupted)
     before = threading.active_count()
     with pytest.raises(KeyboardInterrupt):

@@ -34,7 +34,6 @@ per history entry, then ``x z`` (profiles) or ``x y z`` (maps, a blank line betw
 rows, as gnuplot expects), in metres, with every float printed to round-trip exactly.
 """
 
-import io
 import json
 import re
 import unicodedata
@@ -113,14 +112,15 @@ def _read_lines(lines, options):
 def write(surface, stream):
     stream.write(header_lines(surface).encode("utf-8"))
     x = surface.origin[0] + surface.spacing[0] * np.arange(surface.points[0])
+    x_text = [repr(position) for position in x.tolist()]  # each row of a map repeats them
     if surface.is_profile:
         stream.write(b"x\tz\n")
-        _write_rows(stream, [x], surface.heights)
+        _write_rows(stream, x_text, "", surface.heights)
         return
     stream.write(b"x\ty\tz\n")
     for row, heights in enumerate(surface.heights):
         y = surface.origin[1] + surface.spacing[1] * row
-        _write_rows(stream, [x, np.full_like(x, y)], heights)
+        _write_rows(stream, x_text, f"\t{float(y)!r}", heights)
         stream.write(b"\n")
 
 
@@ -139,11 +139,12 @@ def header_lines(surface):
     return "".join(f"# {line}\n" for line in lines)
 
 
-def _write_rows(stream, columns, heights):
+def _write_rows(stream, x_text, y_text, heights):
+    """Lines of x, y and z: x as printed, y printed once ("" for a profile), z by repr."""
     for start in range(0, len(heights), 65536):
-        chunk = [c[start : start + 65536] for c in (*columns, heights)]
-        rows = ("\t".join(map(repr, values)) for values in zip(*(c.tolist() for c in chunk)))
-        stream.write(("\n".join(rows) + "\n").encode("ascii"))
+        z = heights[start : start + 65536].tolist()
+        lines = "\n".join([f"{x}{y_text}\t{value!r}" for x, value in zip(x_text[start : start + 65536], z)])
+        stream.write((lines + "\n").encode("ascii"))
 
 
 # -- dialects ------------------------------------------------------------------------
@@ -336,15 +337,18 @@ def _numbers(body, delimiter, columns):
     ``columns`` defaults to as many as the first line has (trailing separators aside)."""
     if not any(line.strip() for line in body):
         raise FormatError("no numeric data found")
-    block = "\n".join(body)
+    rows, block = body, "\n".join(body)  # loadtxt takes the lines as a list: a StringIO costs 4 bytes a character
     if delimiter in (";", "\t") and any("," in line for line in body[:10]):
         block = block.replace(",", ".")
+        rows = None
     if any(marker in block for marker in ("BAD", "bad", "Bad")):
         block = _BAD.sub("nan", block)
+        rows = None
+    rows = rows or block.split("\n")
     if columns is None:
         columns = range(len(_split(body[0].rstrip(delimiter or None), delimiter)))
     try:
-        table = np.loadtxt(io.StringIO(block), delimiter=delimiter, usecols=tuple(columns), ndmin=2, comments=None)
+        table = np.loadtxt(rows, delimiter=delimiter, usecols=tuple(columns), ndmin=2, comments=None)
     except ValueError as error:
         row = re.search(r",? at row (\d+)", str(error))
         if row and int(row.group(1)) < len(body):
@@ -489,7 +493,7 @@ def _grid(table, units, settings):
         raise FormatError(f"x y z points cover only {len(z)} of the {nx}×{ny} grid they span")
     heights = np.full((ny, nx), np.nan)
     flat = iy * nx + ix
-    if len(np.unique(flat)) != len(flat):
+    if np.count_nonzero(np.bincount(flat, minlength=nx * ny)) != len(flat):
         raise FormatError("x y z grid has more than one height at the same point")
     heights.ravel()[flat] = z * factors[2]
     metadata, surface_units, history = _provenance(settings, Units(units[0], units[2]))

@@ -47,6 +47,7 @@ edge motifs. A part of the map cut off by invalid points has its own motifs.
 """
 
 import dataclasses
+import logging
 import math
 
 import numpy as np
@@ -69,6 +70,10 @@ FEATURE = {
 KINDS = ("hills", "dales")
 EDGES = ("exclude", "include")
 EIGHT = np.ones((3, 3), dtype=bool)
+log = logging.getLogger("rough")
+COMPILED_MIN = 1 << 20  # points from which the compiled passes pay for loading numba (~0.35 s)
+COMPILED_SADDLES = 1 << 16  # saddles from which the compiled Kruskal loop pays for it
+BAND = 1 << 20  # points a call of a compiled pass covers, between chances to stop it
 # one of each pair of opposite 8-neighbours: along x, along y, and the two diagonals
 NEIGHBOURS = (
     (np.s_[:, :-1], np.s_[:, 1:]),
@@ -237,10 +242,12 @@ def segment(surface, kind="hills", pruning=5.0):
     if kind not in KINDS:
         raise InputError(f"kind must be one of {', '.join(KINDS)}, not {kind!r}")
     pruning = _pruning(pruning)
-    image = -levels if kind == "hills" else levels
-    low, high = float(image[valid].min()), float(image[valid].max())
+    filled = np.negative(levels, out=levels) if kind == "hills" else levels  # levels is ours: in place
+    low, high = float(np.nanmin(filled)), float(np.nanmax(filled))
     threshold = pruning * (high - low) / 100.0
-    filled = np.where(valid, image, high)  # invalid points never make a minimum
+    filled[~valid] = high  # invalid points never make a minimum
+    route = "compiled passes" if filled.size >= COMPILED_MIN else "array operations"
+    log.info(f"segmenting {kind}: {filled.shape[1]} × {filled.shape[0]} points by {route}")
     labels, count = _basins(filled, valid)
     regions = _regions(filled, labels, count)
     lut, roots = _prune(regions, threshold)
@@ -389,10 +396,22 @@ def _pruning(pruning):
 def _basins(filled, valid):
     """One watershed region per regional minimum of ``filled`` (8-connected), within
     ``valid``; a connected part of the valid points without a minimum (a constant
-    one) gets one at its lowest point. Returns the labels (0 outside) and their count."""
+    one) gets one at its lowest point. Returns the labels (0 outside) and their count:
+    scikit-image's watershed from those markers, taken by steepest descent where that
+    gives the same regions (:func:`_descend`) on maps large enough to pay for it."""
+    markers, count = _markers(filled, valid)
+    labels = _descend(filled, valid, markers) if filled.size >= COMPILED_MIN else None
+    if labels is None:
+        from skimage.segmentation import watershed
+
+        labels = watershed(filled, markers, connectivity=2, mask=valid)
+    return labels, count
+
+
+def _markers(filled, valid):
+    """The markers of :func:`_basins`, numbered 1 … count, and their count."""
     from scipy import ndimage
     from skimage.morphology import local_minima
-    from skimage.segmentation import watershed
 
     minima = local_minima(filled, connectivity=2, allow_borders=True) & valid
     markers, count = ndimage.label(minima, structure=EIGHT)
@@ -403,14 +422,112 @@ def _basins(filled, valid):
     for position in ndimage.minimum_position(filled, parts, missing) if missing.size else ():
         count += 1
         markers[position] = count
-    return watershed(filled, markers, connectivity=2, mask=valid), count
+    return markers, count
+
+
+def _descend(filled, valid, markers):
+    """The regions of :func:`_basins` by steepest descent, or None where it does not
+    decide them.
+
+    scikit-image's watershed floods from the markers, lowest first, and labels a point
+    from the first labelled neighbour that reaches it. When every valid point that is
+    not a marker has a neighbour strictly lower than itself, the flood reaches it first
+    from its lowest neighbours (all lower points are flooded before any higher one), so
+    it takes their label, when they share one. That holds for almost every map of
+    float heights; on a plateau, or where a point's lowest neighbours lie in two
+    basins, the order of arrival decides and this returns None. Compiled, a band of
+    rows a call, so that Ctrl-C stops it between bands."""
+    from ..compiled import compiled
+
+    kernel, labels = compiled(_descend_rows), markers.copy()
+    ny, nx = filled.shape
+    band = max(1, BAND // nx)
+    stack = np.empty(1024, dtype=np.int64)
+    heights, inside, flat = filled.ravel(), valid.ravel(), labels.ravel()
+    for first in range(0, ny, band):
+        stack = kernel(heights, inside, flat, nx, first * nx, min(ny, first + band) * nx, stack)
+        if stack.size == 0:
+            return None
+    return labels
+
+
+def _descend_rows(heights, valid, labels, nx, start, stop, stack):
+    """Label the points start … stop - 1 (and those their descents pass through) for
+    :func:`_descend`, all arrays flat; returns the stack, grown as needed, or an empty
+    one where the descent does not decide. Plain Python, compiled by
+    :func:`rough.compiled.compiled`."""
+    ny = heights.size // nx
+    for origin in range(start, stop):
+        if labels[origin] != 0 or not valid[origin]:
+            continue
+        top = 0
+        stack[0] = origin
+        while top >= 0:
+            point = stack[top]
+            if labels[point] != 0:
+                top -= 1
+                continue
+            i, j = point // nx, point % nx
+            lowest, below = heights[point], -1
+            for row in range(max(i - 1, 0), min(i + 2, ny)):
+                for q in range(row * nx + max(j - 1, 0), row * nx + min(j + 2, nx)):
+                    if valid[q] and heights[q] < lowest:
+                        lowest, below = heights[q], q
+            if below < 0:  # a plateau: the order of arrival decides
+                return stack[:0]
+            label, waiting = 0, -1
+            for row in range(max(i - 1, 0), min(i + 2, ny)):
+                for q in range(row * nx + max(j - 1, 0), row * nx + min(j + 2, nx)):
+                    if valid[q] and heights[q] == lowest:
+                        if labels[q] == 0:
+                            waiting = q
+                        elif label == 0:
+                            label = labels[q]
+                        elif labels[q] != label:  # lowest neighbours in two basins
+                            return stack[:0]
+            if waiting < 0:
+                labels[point] = label
+                top -= 1
+                continue
+            top += 1
+            if top == stack.size:
+                grown = np.empty(2 * stack.size, dtype=stack.dtype)
+                grown[: stack.size] = stack
+                stack = grown
+            stack[top] = waiting
+    return stack
 
 
 def _regions(filled, labels, count):
     """Per region (index 1..count; index 0 is the invalid points): the lowest value and
     the index of its first point in row-major order, the highest value, the number of
     points, whether it touches the border or an invalid point; and the pairs of
-    8-neighbouring points in different regions with their pour heights."""
+    8-neighbouring points in different regions with their pour heights (the higher of
+    the two values; some pairs of the same two regions may be kept as one, at the
+    lowest of their pour heights). Compiled passes on large maps, whole-array
+    operations on small ones."""
+    if filled.size < COMPILED_MIN:
+        return _regions_by_masks(filled, labels, count)
+    from ..compiled import compiled
+
+    kernel, heights, flat_labels = compiled(_region_pass), filled.ravel(), labels.ravel()
+    low, high = np.full(count + 1, np.inf), np.full(count + 1, -np.inf)
+    pit, area, edge = np.zeros(count + 1, np.int64), np.zeros(count + 1, np.int64), np.zeros(count + 1, bool)
+    bands = range(0, heights.size, BAND)  # between them, Ctrl-C can stop it
+    figures = (heights, flat_labels, labels.shape[1], low, high, pit, area, edge)
+    first, second, pour, pairs = np.empty(0, flat_labels.dtype), np.empty(0, flat_labels.dtype), np.empty(0), 0
+    for start in bands:
+        pairs = kernel(*figures, False, first, second, pour, start, min(start + BAND, heights.size), pairs)
+    first, second, pour = np.empty(pairs, flat_labels.dtype), np.empty(pairs, flat_labels.dtype), np.empty(pairs)
+    pairs = 0
+    for start in bands:
+        pairs = kernel(*figures, True, first, second, pour, start, min(start + BAND, heights.size), pairs)
+    edge[0] = False
+    return dict(low=low, high=high, pit=pit, area=area, edge=edge, first=first, second=second, pour=pour)
+
+
+def _regions_by_masks(filled, labels, count):
+    """:func:`_regions` by whole-array operations, for small maps."""
     flat_labels, flat = labels.ravel(), filled.ravel()
     low = np.full(count + 1, np.inf)
     np.minimum.at(low, flat_labels, flat)
@@ -448,6 +565,45 @@ def _regions(filled, labels, count):
     }
 
 
+def _region_pass(heights, labels, nx, low, high, pit, area, edge, listing, first, second, pour, start, stop, pairs):
+    """Points start … stop - 1 of a pass of :func:`_regions` over the flat arrays, the
+    pairs numbered from ``pairs`` on: not ``listing``, the regions' figures and the
+    number of neighbouring pairs in different regions; ``listing``, the pairs
+    themselves into ``first``, ``second``, ``pour``. Returns the number of pairs so far. A pair of the same
+    two regions as the pair before it is kept as one, at the lower pour height (what
+    the pairs are used for is a minimum over each two regions' pairs). Plain Python,
+    compiled by :func:`rough.compiled.compiled`."""
+    ny, last_label, last_other = heights.size // nx, 0, 0
+    for point in range(start, stop):
+        i, j, label = point // nx, point % nx, labels[point]
+        if not listing and label > 0:
+            value = heights[point]
+            if value < low[label]:
+                low[label], pit[label] = value, point
+            high[label] = max(high[label], value)
+            area[label] += 1
+            if i == 0 or j == 0 or i == ny - 1 or j == nx - 1:
+                edge[label] = True
+        for row, column in ((i, j + 1), (i + 1, j - 1), (i + 1, j), (i + 1, j + 1)):  # the pairs onwards
+            if row >= ny or not 0 <= column < nx or labels[row * nx + column] == label:
+                continue
+            q = row * nx + column
+            other = labels[q]
+            if label == 0 or other == 0:
+                edge[label + other] = True  # the other one borders an invalid point
+                continue
+            height = max(heights[point], heights[q])
+            if label == last_label and other == last_other:
+                if listing:
+                    pour[pairs - 1] = min(pour[pairs - 1], height)
+                continue
+            if listing:
+                first[pairs], second[pairs], pour[pairs] = label, other, height
+            pairs += 1
+            last_label, last_other = label, other
+    return pairs
+
+
 def _prune(regions, threshold):
     """Wolf pruning on the graph of regions. Returns the lookup table from region
     labels to motif labels (0 stays 0; motifs numbered in row-major order of their
@@ -462,7 +618,9 @@ def _prune(regions, threshold):
     low, pit = regions["low"], regions["pit"]
     first, second, pour = regions["first"], regions["second"], regions["pour"]
     count = low.size - 1
-    near = pour - np.maximum(low[first], low[second]) < threshold
+    near = np.empty(first.size, dtype=bool)
+    for block in _blocks(first.size):  # no temporaries as long as the pairs
+        near[block] = pour[block] - np.maximum(low[first[block]], low[second[block]]) < threshold
     one, other = np.minimum(first[near], second[near]), np.maximum(first[near], second[near])
     parent = np.arange(count + 1)
     if one.size:
@@ -487,25 +645,33 @@ def _prune(regions, threshold):
 
 
 def _kruskal(one, other, saddles, low, pit, threshold, count):
-    """The union-find forest of :func:`_prune` (a loop over saddles, not points)."""
-    parent = list(range(count + 1))
-    depth, place = low.tolist(), pit.tolist()
+    """The union-find forest of :func:`_prune`, a loop over the saddles: compiled for
+    many saddles, in plain Python over lists for a few."""
+    if one.size < COMPILED_SADDLES:
+        lists = (one.tolist(), other.tolist(), saddles.tolist(), low.tolist(), pit.tolist())
+        return np.array(_kruskal_loop(*lists, threshold, list(range(count + 1))))
+    from ..compiled import compiled
 
-    def find(a):
-        while parent[a] != a:
+    return compiled(_kruskal_loop)(one, other, saddles, low, pit, threshold, np.arange(count + 1))
+
+
+def _kruskal_loop(one, other, saddles, low, pit, threshold, parent):
+    """Plain Python, compiled by :func:`rough.compiled.compiled` for arrays."""
+    for k in range(len(one)):
+        a, b = one[k], other[k]
+        while parent[a] != a:  # the roots, halving the paths
             parent[a] = parent[parent[a]]
             a = parent[a]
-        return a
-
-    for a, b, saddle in zip(one.tolist(), other.tolist(), saddles.tolist()):
-        a, b = find(a), find(b)
+        while parent[b] != b:
+            parent[b] = parent[parent[b]]
+            b = parent[b]
         if a == b:
             continue
-        if (depth[b], place[b]) < (depth[a], place[a]):
+        if low[b] < low[a] or (low[b] == low[a] and pit[b] < pit[a]):
             a, b = b, a
-        if saddle - depth[b] < threshold:
+        if saddles[k] - low[b] < threshold:
             parent[b] = a
-    return np.array(parent)
+    return parent
 
 
 def _motifs(surface, kind, filled, labels, lut, roots, regions):
@@ -517,14 +683,17 @@ def _motifs(surface, kind, filled, labels, lut, roots, regions):
     edge = np.bincount(members, weights=regions["edge"][1:], minlength=count + 1) > 0
     high = np.full(count + 1, -np.inf)
     np.maximum.at(high, members, regions["high"][1:])
-    one, other = lut[regions["first"]], lut[regions["second"]]
-    across = one != other
-    pour = regions["pour"][across]
     saddle = np.full(count + 1, np.inf)
-    np.minimum.at(saddle, one[across], pour)
-    np.minimum.at(saddle, other[across], pour)
+    for block in _blocks(regions["first"].size):
+        one, other = lut[regions["first"][block]], lut[regions["second"][block]]
+        across = one != other
+        pour = regions["pour"][block][across]
+        np.minimum.at(saddle, one[across], pour)
+        np.minimum.at(saddle, other[across], pour)
     base = np.where(np.isfinite(saddle), saddle, high)
-    below = np.maximum(base[labels] - filled, 0.0)
+    below = base[labels]
+    below -= filled
+    np.maximum(below, 0.0, out=below)
     dx, dy = surface.spacing
     volume = np.bincount(labels.ravel(), weights=below.ravel(), minlength=count + 1) * (dx * dy)
     rows, columns = np.divmod(regions["pit"][roots], filled.shape[1])
@@ -546,6 +715,11 @@ def _motifs(surface, kind, filled, labels, lut, roots, regions):
         )
         for n in range(1, count + 1)
     )
+
+
+def _blocks(size, block=1 << 18):
+    """Slices covering ``range(size)``, ``block`` at a time."""
+    return (slice(start, start + block) for start in range(0, size, block))
 
 
 def _curvature(heights, rows, columns, dx, dy):

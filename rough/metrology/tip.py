@@ -42,13 +42,13 @@ Invalid points (NaN) never touch the tip; results are NaN where the input is.
 Beyond the ends there is no surface: a tip over an end rests on the points inside.
 """
 
-import functools
 import logging
 import math
 import os
 
 import numpy as np
 
+from ..compiled import compiled
 from ..errors import InputError
 
 log = logging.getLogger("rough")
@@ -274,7 +274,7 @@ def _max_plus(image, radius, spacing, label="tip"):
     chunk = max(1, min(round(CHUNK_SECONDS / per_task), math.ceil(tasks / _cores())))  # every core gets some
     queue = [(first, min(tasks, first + chunk)) for first in reversed(range(0, tasks, chunk))]
     threads = min(_cores(), len(queue))
-    kernel, result = _kernel(), np.empty_like(rows)
+    kernel, result = compiled(_rows), np.empty_like(rows)
     # compiled (or loaded from numba's cache) here, in the main thread, where Ctrl-C can stop it
     kernel(rows, quadrant, widths, swept, squared_radii, spacing[0], tiles, 0, 0, result)
     across = [2 * n - 1 for n in reversed(quadrant.shape)]  # x first
@@ -328,19 +328,6 @@ def _seconds_per_point(widths):
     return float(np.sum(SECONDS_PER_PAIR + np.minimum((widths + 1) * SECONDS_PER_PAIR, SECONDS_PER_SWEEP)))
 
 
-@functools.cache
-def _kernel():
-    """:func:`_rows` compiled by numba, imported here only (``rough`` starts without it).
-    Compiled once per process, or loaded from numba's cache on disk when it finds a
-    writable place for one (beside this file or in the user's cache directory)."""
-    import numba
-
-    try:
-        return numba.njit(nogil=True, cache=True, error_model="numpy")(_rows)
-    except RuntimeError:  # no writable cache directory: compile in every process
-        return numba.njit(nogil=True, error_model="numpy")(_rows)
-
-
 def _rows(image, quadrant, widths, swept, squared_radii, dx, tiles, first, last, out):
     """Tasks ``first`` … ``last - 1`` of the dilation, task i being the tile
     ``i % tiles`` (of ``tiles`` equal ones) of the row ``i // tiles``::
@@ -349,7 +336,7 @@ def _rows(image, quadrant, widths, swept, squared_radii, dx, tiles, first, last,
                     max(image[y - k, c + x], image[y + k, c + x]) + quadrant[k, |x|]
 
     with -inf beyond the ends, row k of the tip directly or (``swept[k]``) by the
-    envelope sweep. Plain Python, compiled by :func:`_kernel`."""
+    envelope sweep. Plain Python, compiled by :func:`rough.compiled.compiled`."""
     count, columns = image.shape
     size = columns // tiles + 1 + 2 * (quadrant.shape[1] - 1)
     line = np.empty(size)  # the two rows' maximum, with margins
