@@ -569,10 +569,10 @@ def _region_pass(heights, labels, nx, low, high, pit, area, edge, listing, first
     """Points start … stop - 1 of a pass of :func:`_regions` over the flat arrays, the
     pairs numbered from ``pairs`` on: not ``listing``, the regions' figures and the
     number of neighbouring pairs in different regions; ``listing``, the pairs
-    themselves into ``first``, ``second``, ``pour``. Returns the number of pairs so far. A pair of the same
-    two regions as the pair before it is kept as one, at the lower pour height (what
-    the pairs are used for is a minimum over each two regions' pairs). Plain Python,
-    compiled by :func:`rough.compiled.compiled`."""
+    themselves into ``first``, ``second``, ``pour``. Returns the number of pairs so
+    far. A pair of the same two regions as the pair before it is kept as one, at the
+    lower pour height (what the pairs are used for is a minimum over each two
+    regions' pairs). Plain Python, compiled by :func:`rough.compiled.compiled`."""
     ny, last_label, last_other = heights.size // nx, 0, 0
     for point in range(start, stop):
         i, j, label = point // nx, point % nx, labels[point]
