@@ -42,6 +42,7 @@ Every function here uses the valid (non-NaN) points only.
 """
 
 import dataclasses
+import functools
 import math
 
 import numpy as np
@@ -199,14 +200,21 @@ class MaterialRatioCurve:
         ordered += 0.0  # -0.0 to 0.0
         self.heights = ordered
         self.ratios = np.linspace(0.0, 100.0, heights.size)
-        self._integral = np.empty(heights.size)
-        self._integral[0] = 0.0
-        steps = self._integral[1:]  # the trapezia, then summed in place
+        self._rounding = ROUNDING * max(abs(float(ordered[0])), abs(float(ordered[-1])))
+
+    @functools.cached_property
+    def _integral(self):
+        """``∫_0^ratios[i] h(q) dq`` at every point of the curve (height × %), by the
+        trapezium rule; made when first needed."""
+        integral = np.empty(self.heights.size)
+        integral[0] = 0.0
+        steps = integral[1:]  # the trapezia, then summed in place
         np.add(self.heights[:-1], self.heights[1:], out=steps)
-        steps *= np.diff(self.ratios)
+        for start in range(0, steps.size, BLOCK):  # the widths without a temporary as long as the curve
+            steps[start : start + BLOCK] *= np.diff(self.ratios[start : start + BLOCK + 1])
         steps /= 2
         np.cumsum(steps, out=steps)
-        self._rounding = ROUNDING * float(np.max(np.abs(self.heights)))
+        return integral
 
     def ratio_at(self, height):
         """Smr(c) (Rmr(c)): the material ratio in % at ``height`` metres about the mean;
@@ -335,7 +343,10 @@ def _two_lines(q, h):
     stride = max(1, (n - 2 * least) // 1024)
     coarse = np.arange(least, n - least, stride)
     ends = np.append(coarse, n)
-    sums = {name: np.cumsum(values)[ends - 1] for name, values in _moments(q, h)}
+    sums = {}
+    for name, values in _moments(q, h):
+        sums[name] = _cumulative(values)[ends - 1]
+        del values  # before the next moment is made
     residual, _ = _broken_lines(q, sums, ends)
     best = int(np.argmin(residual))
     before = max(0, best - 1)  # the window starts at a coarse break, whose running sums are known
@@ -347,6 +358,11 @@ def _two_lines(q, h):
     intercept, valley, plateau = coefficients[best]
     deviate = float(q[fine[best]])
     return ProbabilityFit(float(plateau), float(valley), float(100.0 * ndtr(-deviate)), deviate, float(intercept))
+
+
+def _cumulative(values):
+    """The running sums of ``values``, in place when they are a temporary of ours."""
+    return np.cumsum(values, out=values if values.base is None else None)
 
 
 def _running(values, before, total):
@@ -469,7 +485,7 @@ def functional_parameters(
 
 
 def _profile(curve, height, ratio, dc_ratios, volume_ratios):
-    core, fit = curve.core(), curve.probability()
+    fit, core = curve.probability(), curve.core()  # the fit's scratch goes before core() makes the integral
     return {
         "Rmr": float(curve.ratio_at(height)),
         "Rmc": float(curve.height_at(ratio)),

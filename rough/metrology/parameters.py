@@ -38,7 +38,7 @@ SLOPES = ("2point", "7point")
 SEVEN_POINT = np.array([1.0, -9.0, 45.0, 0.0, -45.0, 9.0, -1.0]) / 60.0
 ROUNDING = 64 * np.finfo(float).eps  # relative: deviations this small are the rounding of the mean (measured ≤ 2.3 eps)
 BLOCK = 1 << 16  # points per block when streaming through a map: cache-sized, no full-size temporaries
-FFT_BLOCK = 1 << 20  # points per block of 1-D transforms: few calls, a few MB of scratch
+FFT_BLOCK = 1 << 18  # points per block of 1-D transforms: few calls, a few MB of scratch
 
 # key: (unit, what it is). Units: "m", "1/m", "1" (dimensionless), "%", "deg".
 PROFILE = {
@@ -579,7 +579,8 @@ def _half_correlation(field, shape):
         lagged[:, columns] = fft.rfft(parts[:, 0::2] + parts[:, 1::2], axis=0, workers=-1)[: hy + 1]
     del along_x, padded, parts
     # the power is real: its inverse transform along y is the conjugate of the forward one
-    correlation = fft.irfft(np.conj(lagged, out=lagged), n=px, axis=1, workers=-1) / py
+    correlation = fft.irfft(np.conj(lagged, out=lagged), n=px, axis=1, workers=-1)
+    correlation /= py
     return np.concatenate([correlation[:, px - hx :], correlation[:, : hx + 1]], axis=1)
 
 
