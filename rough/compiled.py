@@ -2,6 +2,9 @@
 (``rough`` starts without it)."""
 
 import functools
+import threading
+
+WAIT = 0.1  # seconds between the caller's chances to be interrupted
 
 
 @functools.cache
@@ -9,6 +12,12 @@ def compiled(function):
     """``function`` compiled by numba (no GIL held, NumPy's error model), once per
     process, or loaded from numba's cache on disk when it finds a writable place for
     one (beside the function's module or in the user's cache directory).
+
+    Each call runs in a worker thread while the caller waits in steps of
+    :data:`WAIT`, so that Ctrl-C stops the caller at once, even during the first
+    call's compilation (numba's compiler would otherwise swallow the interrupt in
+    one of its ctypes callbacks and carry on). An interrupted call finishes in the
+    background and its result is dropped.
 
     Parameters
     ----------
@@ -18,8 +27,8 @@ def compiled(function):
     Returns
     -------
     callable
-        The compiled dispatcher; its first call compiles (a second or two) or loads
-        the cached machine code.
+        Calls the compiled function; its first call compiles (a second or two) or
+        loads the cached machine code.
 
     Examples
     --------
@@ -32,6 +41,26 @@ def compiled(function):
     import numba
 
     try:
-        return numba.njit(nogil=True, cache=True, error_model="numpy")(function)
+        dispatcher = numba.njit(nogil=True, cache=True, error_model="numpy")(function)
     except RuntimeError:  # no writable cache directory: compile in every process
-        return numba.njit(nogil=True, error_model="numpy")(function)
+        dispatcher = numba.njit(nogil=True, error_model="numpy")(function)
+    return functools.partial(_waited, dispatcher)
+
+
+def _waited(dispatcher, *args):
+    outcome = []
+
+    def work():
+        try:
+            outcome.append((dispatcher(*args), None))
+        except BaseException as error:  # handed to the caller
+            outcome.append((None, error))
+
+    worker = threading.Thread(target=work, name=f"rough: {dispatcher.__name__}", daemon=True)
+    worker.start()
+    while worker.is_alive():
+        worker.join(WAIT)
+    result, error = outcome[0]
+    if error is not None:
+        raise error
+    return result

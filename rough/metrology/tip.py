@@ -275,7 +275,7 @@ def _max_plus(image, radius, spacing, label="tip"):
     queue = [(first, min(tasks, first + chunk)) for first in reversed(range(0, tasks, chunk))]
     threads = min(_cores(), len(queue))
     kernel, result = compiled(_rows), np.empty_like(rows)
-    # compiled (or loaded from numba's cache) here, in the main thread, where Ctrl-C can stop it
+    # compiled (or loaded from numba's cache) here, before the workers start; Ctrl-C stops the wait
     kernel(rows, quadrant, widths, swept, squared_radii, spacing[0], tiles, 0, 0, result)
     across = [2 * n - 1 for n in reversed(quadrant.shape)]  # x first
     kernel_size = f"{across[0]} × {across[1]}" if count > 1 else str(across[0])
