@@ -21,7 +21,8 @@ from rough.metrology import (
     split,
     transmission,
 )
-from rough.metrology.filters import ALPHA
+from rough.metrology.features import local_maxima
+from rough.metrology.filters import ALPHA, convolved, gaussian_kernel
 
 from conftest import surfalize_heights
 
@@ -387,3 +388,36 @@ def test_waviness_needs_a_cutoff():
 
 def test_math_is_consistent():
     assert math.isclose(ALPHA, math.sqrt(math.log(2) / math.pi))
+
+
+# -- the pieces that stand in for scipy.signal (whose import costs half a second) ------
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    st.lists(st.sampled_from([-np.inf, -2.0, -1.0, 0.0, 1.0, 2.0, np.inf]), max_size=40),
+)
+def test_local_maxima_are_those_of_find_peaks(values):
+    from scipy.signal import find_peaks
+
+    values = np.array(values, dtype=np.float64)
+    assert local_maxima(values).tolist() == find_peaks(values)[0].tolist()
+
+
+@settings(max_examples=150, deadline=None)
+@given(
+    st.integers(1, 3),
+    st.integers(1, 3000),  # up to many segments of the overlap-add
+    st.integers(0, 60),
+    st.integers(0, 1),
+    st.integers(0, 2**32 - 1),
+)
+def test_the_convolution_is_oaconvolves(lines, length, reach, axis, seed):
+    from scipy.signal import oaconvolve
+
+    rng = np.random.default_rng(seed)
+    values = rng.standard_normal((lines, length) if axis else (length, lines)) * 10.0 ** rng.uniform(-9, 3)
+    kernel = gaussian_kernel(1.0, reach + 0.5)
+    expected = oaconvolve(values, kernel.reshape((1, -1) if axis else (-1, 1)), mode="same", axes=axis)
+    scale = np.max(np.abs(values)) * np.sum(np.abs(kernel))
+    np.testing.assert_allclose(convolved(values, kernel, axis), expected, rtol=0, atol=1e-13 * scale)

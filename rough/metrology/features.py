@@ -184,11 +184,9 @@ def _runs_above(signed, threshold, extension):
 
 
 def _extremes_above(signed, x, threshold, extension):
-    from scipy.signal import find_peaks
-
     values = np.nan_to_num(signed, nan=-np.inf)
-    tops, _ = find_peaks(values)
-    bottoms, _ = find_peaks(-np.nan_to_num(signed, nan=np.inf))
+    tops = local_maxima(values)
+    bottoms = local_maxima(-np.nan_to_num(signed, nan=np.inf))
     spans = []
     for top in tops:
         left = bottoms[bottoms < top]
@@ -198,6 +196,41 @@ def _extremes_above(signed, x, threshold, extension):
         if values[top] > threshold + extension * (x[stop - 1] - x[start]):
             spans.append((start, stop))
     return spans
+
+
+def local_maxima(values):
+    """The indices of the local maxima of a 1-D array, as ``scipy.signal.find_peaks``
+    gives them with no condition (without importing ``scipy.signal``, which costs half
+    a second): a point, or a plateau of equal values, higher than the points on both
+    sides; a plateau counts once, at its middle (the left one of two middles); the
+    ends are never maxima.
+
+    Parameters
+    ----------
+    values : numpy.ndarray of float
+        No NaN (compare ±inf instead).
+
+    Returns
+    -------
+    numpy.ndarray of int
+        Ascending.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from rough.metrology.features import local_maxima
+    >>> local_maxima(np.array([0.0, 2.0, 1.0, 3.0, 3.0, 3.0, 3.0, 0.0, 5.0])).tolist()
+    [1, 4]
+    """
+    values = np.asarray(values)
+    if values.size < 3:
+        return np.empty(0, dtype=np.intp)
+    starts = np.flatnonzero(np.r_[True, values[1:] != values[:-1]])  # of the runs of equal values
+    ends = np.r_[starts[1:], values.size] - 1
+    inner = (starts > 0) & (ends < values.size - 1)
+    starts, ends = starts[inner], ends[inner]
+    higher = (values[starts - 1] < values[starts]) & (values[ends + 1] < values[starts])
+    return ((starts[higher] + ends[higher]) // 2).astype(np.intp)
 
 
 def _describe(kind, signed, x, start, stop):
