@@ -13,11 +13,12 @@ def compiled(function):
     process, or loaded from numba's cache on disk when it finds a writable place for
     one (beside the function's module or in the user's cache directory).
 
-    Each call runs in a worker thread while the caller waits in steps of
-    :data:`WAIT`, so that Ctrl-C stops the caller at once, even during the first
-    call's compilation (numba's compiler would otherwise swallow the interrupt in
-    one of its ctypes callbacks and carry on). An interrupted call finishes in the
-    background and its result is dropped.
+    A call from the main thread runs in a worker thread while the caller waits in
+    steps of :data:`WAIT`, so that Ctrl-C stops the caller at once, even during the
+    first call's compilation (numba's compiler would otherwise swallow the interrupt
+    in one of its ctypes callbacks and carry on). An interrupted call finishes in the
+    background and its result is dropped. A call from another thread, which Ctrl-C
+    never interrupts, runs where it is.
 
     Parameters
     ----------
@@ -48,6 +49,8 @@ def compiled(function):
 
 
 def _waited(dispatcher, *args):
+    if threading.current_thread() is not threading.main_thread():
+        return dispatcher(*args)
     outcome = []
 
     def work():

@@ -70,3 +70,22 @@ def test_a_compiled_call_returns_its_result_and_raises_its_errors():
     assert kernel(np.array([3.0, 1.0, -2.0])) == 2
     with pytest.raises(ValueError, match="no negative value"):
         kernel(np.array([1.0]))
+
+
+def test_a_call_from_another_thread_runs_in_that_thread():
+    import threading
+
+    from rough.compiled import _waited
+
+    class Where:
+        __name__ = "where"
+
+        def __call__(self):
+            return threading.current_thread()
+
+    seen = []
+    worker = threading.Thread(target=lambda: seen.append((threading.current_thread(), _waited(Where()))))
+    worker.start()
+    worker.join()
+    assert seen[0][0] is seen[0][1] is worker
+    assert _waited(Where()) is not threading.main_thread()  # from the main thread: a worker runs it

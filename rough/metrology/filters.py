@@ -25,10 +25,10 @@ import numpy as np
 
 from ..errors import InputError
 from ..units import format_length
+from .parameters import FFT_BLOCK
 
 ALPHA = math.sqrt(math.log(2.0) / math.pi)
 ENDS = ("trim", "correct")
-FFT_LINES = 1 << 20  # points of padded transform per block of lines
 
 
 def gaussian_kernel(spacing, cutoff):
@@ -79,7 +79,7 @@ def convolved(values, kernel, axis=-1):
     response = fft.rfft(kernel, size)
     flat = lines.reshape(-1, n)
     out = np.empty_like(flat)
-    step = max(1, FFT_LINES // (count * size))
+    step = max(1, FFT_BLOCK // (count * size))
     for first in range(0, flat.shape[0], step):
         block = flat[first : first + step]
         padded = np.zeros((block.shape[0], count * length))

@@ -513,15 +513,17 @@ def _regions(filled, labels, count):
     kernel, heights, flat_labels = compiled(_region_pass), filled.ravel(), labels.ravel()
     low, high = np.full(count + 1, np.inf), np.full(count + 1, -np.inf)
     pit, area, edge = np.zeros(count + 1, np.int64), np.zeros(count + 1, np.int64), np.zeros(count + 1, bool)
-    bands = range(0, heights.size, BAND)  # between them, Ctrl-C can stop it
     figures = (heights, flat_labels, labels.shape[1], low, high, pit, area, edge)
-    first, second, pour, pairs = np.empty(0, flat_labels.dtype), np.empty(0, flat_labels.dtype), np.empty(0), 0
-    for start in bands:
-        pairs = kernel(*figures, False, first, second, pour, start, min(start + BAND, heights.size), pairs)
+
+    def sweep(listing, first, second, pour):  # a band at a time: between them, Ctrl-C can stop it
+        pairs = 0
+        for start in range(0, heights.size, BAND):
+            pairs = kernel(*figures, listing, first, second, pour, start, min(start + BAND, heights.size), pairs)
+        return pairs
+
+    pairs = sweep(False, np.empty(0, flat_labels.dtype), np.empty(0, flat_labels.dtype), np.empty(0))
     first, second, pour = np.empty(pairs, flat_labels.dtype), np.empty(pairs, flat_labels.dtype), np.empty(pairs)
-    pairs = 0
-    for start in bands:
-        pairs = kernel(*figures, True, first, second, pour, start, min(start + BAND, heights.size), pairs)
+    sweep(True, first, second, pour)
     edge[0] = False
     return dict(low=low, high=high, pit=pit, area=area, edge=edge, first=first, second=second, pour=pour)
 
