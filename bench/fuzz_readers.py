@@ -1,8 +1,8 @@
 """Coverage-guided fuzzing of every reader with atheris (libFuzzer for Python):
 ``rough.io.read_bytes`` must turn any input into a surface or an InputError, never
-another exception, a crash or a hang. Seeds: the valid files of tests/seed_files.py and
-the hostile corpus. Not part of the test suite (tests/test_fuzz.py is its quick
-hypothesis-driven cousin).
+another exception, a crash or a hang. Seeds: the valid files of tests/seed_files.py, the
+measured-float and ±1e308 files of tests/damaged_files.py, and the hostile corpus. Not
+part of the test suite (tests/test_fuzz.py is its quick hypothesis-driven cousin).
 
     make fuzz     # or: pip install -e '.[fuzz]'; python bench/fuzz_readers.py -runs=1000000 -max_len=8192 -timeout=10
 
@@ -42,10 +42,12 @@ def one_input(data):
 
 
 def seed_folder():
+    from damaged_files import measured_seeds, written_huge
     from seed_files import seeds
 
     folder = pathlib.Path(tempfile.mkdtemp(prefix="rough-fuzz-"))
-    for name, blob in seeds().items():  # the seeds' own names are lost: NAMES covers extension-only formats
+    every = {**seeds(), **measured_seeds(), **written_huge()}
+    for name, blob in every.items():  # the seeds' own names are lost: NAMES covers extension-only formats
         (folder / name).write_bytes(blob)
     for path in (HERE.parent / "tests" / "hostile").iterdir():
         if path.suffix not in (".py", ".tsv") and path.stat().st_size <= 1 << 16:

@@ -21,7 +21,7 @@ is cheap and the command line starts quickly. ``rough.metrology``, ``rough.fract
 
 import importlib
 
-__version__ = "0.9.4"
+__version__ = "0.10.0"
 
 # public name -> module that defines it (imported on first use)
 _LAZY = {

@@ -7,7 +7,9 @@ atomically as PNG, SVG or PDF.
 Maps are drawn by one piece of code everywhere (:func:`surface_figure`, and the map
 panel of :func:`features_figure`): heights in a perceptual colour map with a colour
 bar in a length unit chosen from the height range, axes in a length unit chosen from
-the extent, equal physical aspect (the figure's shape follows the map's, within
+the extent, y upwards (row 0 at the bottom, so a georeferenced DEM is north up and
+angles counter-clockwise from +x, as ``rose`` and Std give them, are counter-clockwise
+on the page), equal physical aspect (the figure's shape follows the map's, within
 limits), a scale bar, and invalid (NaN) points in light grey, counted in a legend.
 """
 
@@ -303,6 +305,7 @@ def _draw_map(
     figure, axes, bar_axes, location, surface, hillshade=False, colormap="viridis", scale_bar=True, quantity="height"
 ):
     """Draw the map ``surface`` on ``axes``: heights in colour at equal physical aspect,
+    y upwards (row 0 at the bottom: north up for a DEM),
     x and y in a length unit chosen from the extent, a colour bar in ``bar_axes`` (at
     the ``location`` ``"right"`` or ``"bottom"``) in a length unit chosen from the
     height range, a scale bar, and NaN points in :data:`INVALID_COLOUR` with a
@@ -326,7 +329,8 @@ def _draw_map(
     shown, (fy, fx) = _block_mean(surface.heights)
     colours = mpl.colormaps[colormap].with_extremes(bad=INVALID_COLOUR)
     norm = Normalize(low * z_scale, high * z_scale)
-    extent = (x0 * scale, (x0 + width) * scale, (y0 + height) * scale, y0 * scale)
+    left, bottom = x0 - dx / 2, y0 - dy / 2  # each sample at the centre of its pixel
+    extent = (left * scale, (left + width) * scale, bottom * scale, (bottom + height) * scale)  # row 0 at the bottom
     if hillshade:
         nan = np.isnan(shown)
         filled = np.where(nan, np.nanmean(shown) if valid.size else 0.0, shown)
@@ -334,22 +338,22 @@ def _draw_map(
         slope = np.hypot(*slopes)[~nan] if len(slopes) == 2 else np.zeros(1)
         typical = float(np.median(slope)) if slope.size else 0.0  # the median: spikes do not set it
         exaggeration = 0.5 / typical if typical > 0 else 1.0  # relief legible whatever the surface's slope
-        light = LightSource(azdeg=315, altdeg=45)
+        light = LightSource(azdeg=315, altdeg=45)  # it takes row 0 as the top: shade the rows top down
         rgba = light.shade(
-            filled,
+            filled[::-1],
             colours,
             norm=Normalize(low, high),
             blend_mode="soft",
             vert_exag=exaggeration,
             dx=dx * fx,
             dy=dy * fy,
-        )
+        )[::-1]
         rgba[nan] = mpl.colors.to_rgba(INVALID_COLOUR)
-        axes.imshow(rgba, extent=extent, origin="upper", interpolation="auto")
+        axes.imshow(rgba, extent=extent, origin="lower", interpolation="auto")
         mappable = mpl.cm.ScalarMappable(norm=norm, cmap=colours)
     else:
         mappable = axes.imshow(
-            np.ma.masked_invalid(shown * z_scale), cmap=colours, norm=norm, extent=extent, origin="upper"
+            np.ma.masked_invalid(shown * z_scale), cmap=colours, norm=norm, extent=extent, origin="lower"
         )
     axes.set_aspect("equal")
     axes.grid(False)
@@ -439,7 +443,8 @@ def surface_figure(surface, title=None, hillshade=False, note=None, colormap="vi
     against position (what ``rough show`` draws).
 
     A map is drawn at equal physical aspect (a 10 mm × 0.5 mm map is a wide strip),
-    in a figure whose shape follows the map's within limits, with x and y in a
+    in a figure whose shape follows the map's within limits, with y upwards (row 0 at
+    the bottom, so a DEM is north up; Gwyddion draws row 0 at the top), x and y in a
     length unit chosen from the extent, a colour bar in a unit chosen from the height
     range (clipped, with arrows, when a few spikes would wash out the rest), a scale
     bar, and invalid (NaN) points in light grey with a legend that counts them. A

@@ -16,8 +16,10 @@ import numpy as np
 from . import __version__
 from .errors import InputError
 
-MAX_POINTS = 1 << 28  # 16384 × 16384: with its spectrum, about 6 GiB of working memory
+MAX_POINTS = 1 << 28  # 16384 × 16384: 2 GiB of heights; `features` takes ~10× that (rough.io.limits)
 SPACING_RANGE = (1e-12, 1e6)  # metres: below atomic resolution or beyond a continent, a unit is wrong
+HEIGHT_LIMIT = 1e5  # metres: no surface on Earth reaches 100 km above or below its mean (Everest 8.8 km)
+RELIEF_LIMIT = 1e3  # heights spanning more than this many times a surface's width: a unit is likely wrong
 
 
 def check_size(shape, what):

@@ -7,8 +7,19 @@ import subprocess
 import sys
 
 import pytest
+from hypothesis import settings
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
+
+# Hypothesis profiles: $HYPOTHESIS_PROFILE names one; else "ci" where $CI is set (as CI
+# services set it), else hypothesis's "default", whose example database is .hypothesis/
+# (or $HYPOTHESIS_STORAGE_DIRECTORY). "ci" explores afresh on every run: no database, so
+# no failure saved by an earlier run replays, and random, not derandomised, examples.
+# "thorough" is "ci" with 5000 examples, for the property tests that take
+# max(1000, the profile's max_examples).
+settings.register_profile("ci", settings.get_profile("ci"), database=None, derandomize=False)
+settings.register_profile("thorough", settings.get_profile("ci"), max_examples=5000)
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE") or ("ci" if os.environ.get("CI") else "default"))
 
 
 def pytest_report_header():
@@ -21,6 +32,12 @@ def shared_folder():
     """``../shared`` beside the checkout (or $ROUGH_SHARED), or None."""
     candidate = pathlib.Path(os.environ.get("ROUGH_SHARED", ROOT.parent / "shared"))
     return candidate if (candidate / "data" / "INDEX.md").is_file() else None
+
+
+def shared_data_path():
+    """Where the third-party data are (``shared/data`` of :func:`shared_folder`), whether
+    or not they are there: for module-level skip marks."""
+    return (shared_folder() or ROOT.parent / "shared") / "data"
 
 
 @pytest.fixture(scope="session")

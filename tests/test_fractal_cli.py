@@ -177,7 +177,7 @@ def test_fit_refusals(tmp_path):
 
     from rough import Surface
 
-    heights = np.sin(np.arange(500) / 7.0)
+    heights = 1e-6 * np.sin(np.arange(500) / 7.0)
     heights[40] = np.nan
     Surface(heights, (1e-6,)).write(tmp_path / "gap.x3p")
     assert_one_line_error(rough("fit-fractal", tmp_path / "gap.x3p"), "--fill")

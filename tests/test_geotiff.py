@@ -6,7 +6,6 @@ outside the raster, damaged files)."""
 import io
 import json
 import math
-import pathlib
 
 import numpy as np
 import pytest
@@ -18,12 +17,12 @@ import rough
 from rough.errors import FormatError, InputError
 from rough.io import ReadOptions, read_bytes
 
-from conftest import assert_one_line_error
+from conftest import assert_one_line_error, shared_data_path
 
 rasterio = pytest.importorskip("rasterio")
 from rasterio.transform import Affine  # noqa: E402
 
-DATA = pathlib.Path(__file__).resolve().parents[1].parent / "shared" / "data"
+DATA = shared_data_path()  # ../shared/data, or $ROUGH_SHARED/data
 DEM = DATA / "dem"
 needs_data = pytest.mark.skipif(not DATA.is_dir(), reason="needs ../shared/data")
 FILES = ("TM1_564_146.tif", "TM1_564_146_nodata.tif", "faultzone.tif")

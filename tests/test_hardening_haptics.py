@@ -43,7 +43,9 @@ def profile():
         (["--max-force", "0"], "--max-force"),
         (["--duration", "0s"], "--duration"),
         (["--velocity-filter", "0"], "--velocity-filter"),
-        (["--rate", "1e7Hz"], "at most 100000 Hz"),
+        (["--rate", "1e7Hz"], "a rate must lie between 0.001 Hz and 100000 Hz"),
+        (["--duration", "1e7s"], "a time must lie between 1e-06 s and 1e+06 s"),
+        (["--duration", "1e300s"], "a time must lie between 1e-06 s and 1e+06 s"),
     ],
 )
 def test_render_refuses_nonsense_values_in_one_line(profile, options, message):
@@ -53,8 +55,7 @@ def test_render_refuses_nonsense_values_in_one_line(profile, options, message):
 @pytest.mark.parametrize(
     "options",
     [
-        ["--duration", "1e7s"],
-        ["--duration", "1e300s"],
+        ["--duration", "1e5s"],
         ["--speed", "1e-4mm/s"],
         ["--rate", "100kHz", "--duration", "3600s"],
         ["--speed", "1mm/s", "--speed", "2mm/s", "--duration", "5000s"],

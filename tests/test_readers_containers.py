@@ -2,7 +2,6 @@
 example files in ../shared/data and their projects' expectations (INDEX.md §2b)."""
 
 import io
-import pathlib
 import shutil
 import subprocess
 import zipfile
@@ -15,7 +14,9 @@ from rough import Surface, read
 from rough.errors import FormatError, InputError
 from rough.io import ReadOptions, read_bytes, registry
 
-DATA = pathlib.Path(__file__).resolve().parents[1].parent / "shared" / "data"
+from conftest import shared_data_path
+
+DATA = shared_data_path()  # ../shared/data, or $ROUGH_SHARED/data
 ST = DATA / "SurfaceTopography"
 needs_data = pytest.mark.skipif(not DATA.is_dir(), reason="needs ../shared/data")
 needs_gwyddion = pytest.mark.skipif(

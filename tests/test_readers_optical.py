@@ -1,8 +1,6 @@
 """Optical-profiler and stylus readers against their example files: Zygo MetroPro, Wyko OPD,
 Bruker OPDx, Nanofocus NMS and Keyence ZON (values from ../shared/data/INDEX.md §2, §2b, §2c)."""
 
-import pathlib
-
 import numpy as np
 import pytest
 from peer_statistics import rq, sq
@@ -11,7 +9,9 @@ import rough
 from rough.errors import FormatError, InputError
 from rough.io import ReadOptions, read_bytes, registry
 
-DATA = pathlib.Path(__file__).resolve().parents[1].parent / "shared" / "data"
+from conftest import shared_data_path
+
+DATA = shared_data_path()  # ../shared/data, or $ROUGH_SHARED/data
 needs_data = pytest.mark.skipif(not DATA.is_dir(), reason="needs ../shared/data")
 
 METROPRO = DATA / "SurfaceTopography" / "metropro-1.dat"

@@ -2,7 +2,6 @@
 FRT MicroProf, TrueMap TMD) against the expectations of the projects their example
 files come from (../shared/data/INDEX.md §2, §2b), and their error paths."""
 
-import pathlib
 import struct
 import zlib
 
@@ -13,7 +12,9 @@ from peer_statistics import rq, sq
 from rough.errors import InputError
 from rough.io import ReadOptions, read_bytes
 
-DATA = pathlib.Path(__file__).resolve().parents[1].parent / "shared" / "data"
+from conftest import shared_data_path
+
+DATA = shared_data_path()  # ../shared/data, or $ROUGH_SHARED/data
 EXAMPLES = DATA / "SurfaceTopography"
 pytestmark = pytest.mark.skipif(not DATA.is_dir(), reason="needs ../shared/data")
 
@@ -105,7 +106,7 @@ def test_frt_grid_size_and_undefined_points(name, shape, size, invalid, date):
 def test_frt_single_image_block_equals_the_topography_channel():
     raw = (EXAMPLES / "frt-1.frt").read_bytes()
     start = raw.index(b"\x0b\x00" + struct.pack("<I", 500 * 500 * 2)) + 6
-    counts = np.frombuffer(raw, "<u2", 500 * 500, start).reshape(500, 500)
+    counts = np.frombuffer(raw, "<u2", 500 * 500, start).reshape(500, 500)[::-1]  # first stored row: the bottom
     scan = load("frt-1.frt")
     np.testing.assert_array_equal(np.isnan(scan.heights), counts == 1)
     np.testing.assert_allclose(scan.heights[counts != 1], counts[counts != 1] * 9.765923032319103e-09, rtol=1e-15)
@@ -124,8 +125,8 @@ def test_mnt1_equals_bcrf1_in_micrometres():
     """mnt-1 is bcrf-1's measurement; bcrf-1's values (nm) are SurfaceTopography's test expectations."""
     scan = load("mnt-1.mnt")
     assert scan.heights.shape == (600, 960) and not np.isnan(scan.heights).any()
-    # MountainsMap's size is (n - 1) steps; SurfaceTopography asserts it to 2 decimals (µm).
-    np.testing.assert_allclose(np.array(scan.spacing) * 1e6 * (959, 599), (1777.404, 1110.878), atol=0.005)
+    # rough's size (n steps) is MountainsMap's extent; SurfaceTopography asserts it to 2 decimals (µm).
+    np.testing.assert_allclose(np.array(scan.size) * 1e6, (1777.404, 1110.878), atol=0.005)
     np.testing.assert_allclose(sq(scan.heights), 24.560207201442292e-9, rtol=1e-6)
     np.testing.assert_allclose(rq(scan.heights), 24.009754961959388e-9, rtol=1e-6)
     np.testing.assert_allclose(rq(scan.heights.T), 24.134045799796326e-9, rtol=1e-6)
@@ -136,7 +137,7 @@ def test_mnt1_equals_bcrf1_in_micrometres():
 def test_mnt2_validity_image_and_height_range():
     scan = load("mnt-2.mnt")
     assert scan.heights.shape == (960, 1280)
-    np.testing.assert_allclose(np.array(scan.spacing) * 1e6 * (1279, 959), (95.77, 71.81), atol=0.05)
+    np.testing.assert_allclose(np.array(scan.size) * 1e6, (95.77, 71.81), atol=0.05)
     invalid = int(np.isnan(scan.heights).sum())
     assert 40000 < invalid < 50000 and invalid == 45405  # SurfaceTopography 1.27.1 also masks 45405
     micrometres = scan.heights * 1e6

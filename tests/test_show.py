@@ -197,6 +197,36 @@ def test_invalid_points_are_counted_and_grey():
     assert "1 mm" in texts(figure)  # the scale bar, a fifth of 6.4 mm or less
 
 
+def page(figure):
+    """The first axes' pixels as drawn (grey levels, row 0 at the top of the page)."""
+    figure.canvas.draw()
+    box = figure.axes[0].get_window_extent()
+    pixels = np.asarray(figure.canvas.buffer_rgba())[..., :3].mean(axis=2)
+    top, bottom = round(pixels.shape[0] - box.y1) + 2, round(pixels.shape[0] - box.y0) - 2
+    return pixels[top:bottom, round(box.x0) + 2 : round(box.x1) - 2]
+
+
+@pytest.mark.parametrize("hillshade", [False, True])
+def test_maps_are_drawn_with_y_upwards(hillshade):
+    """Row 0 at the bottom: a bump at large x and large y (the last rows) is drawn at the upper right, the y axis
+    increases upwards from the first sample's pixel edge, and a hill-shaded bump is lit from the upper left."""
+    y, x = np.mgrid[0:60, 0:80]
+    bump = 1e-6 * np.exp(-((x - 60) ** 2 + (y - 45) ** 2) / 30.0)
+    scan = rough.Surface(bump, spacing=10e-6, origin=(0.0, 1e-3))
+    figure = plots.surface_figure(scan, colormap="gray", hillshade=hillshade)
+    assert figure.axes[0].get_ylabel() == "y (µm)"
+    assert figure.axes[0].get_ylim() == pytest.approx((995, 1595))  # y0 − dy/2 to y0 + 60 dy − dy/2
+    image = page(figure)
+    rows, columns = image.shape
+    if not hillshade:
+        row, column = np.unravel_index(np.argmax(image), image.shape)
+        assert row < 0.35 * rows and column > 0.65 * columns, (row, column, image.shape)
+    else:  # the bump's centre on the page, then its north-west and south-east flanks
+        row, column = round(rows * (1 - 45.5 / 60)), round(columns * 60.5 / 80)
+        step = round(columns * 3 / 80)
+        assert image[row - step, column - step] > image[row + step, column + step] + 20
+
+
 def test_units_follow_the_sizes():
     small = rough.Surface(np.random.default_rng(6).normal(size=(64, 64)) * 5e-9, spacing=1e-6)  # 64 µm, nm heights
     figure = plots.surface_figure(small)

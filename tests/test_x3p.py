@@ -58,7 +58,8 @@ def test_integer_types_are_signed_in_what_rough_reads():
     surface = read_bytes(x3p_file(raw, code="I", increment=1e-9, offset=0.0))
     assert surface.heights.tolist() == [-32768e-9, -1e-9, 0.0, 32767e-9]
     raw32 = np.array([[-(2**31), -5, 2**31 - 1]], dtype=np.int32)
-    assert read_bytes(x3p_file(raw32, code="L", increment=1.0)).heights.tolist() == [-(2.0**31), -5.0, 2.0**31 - 1]
+    heights = read_bytes(x3p_file(raw32, code="L", increment=1e-9)).heights  # 2**31 m would be refused: > 100 km
+    assert heights.tolist() == (raw32[0].astype(np.float64) * 1e-9).tolist()
 
 
 def test_binary_data_start_aligned_for_zero_copy_reading():

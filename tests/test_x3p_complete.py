@@ -7,7 +7,6 @@ placements and axes the samples lack."""
 import hashlib
 import io
 import logging
-import pathlib
 import re
 import zipfile
 from xml.etree import ElementTree
@@ -18,7 +17,9 @@ import pytest
 from rough.errors import FormatError, InputError
 from rough.io import ReadOptions, read, read_bytes
 
-DATA = pathlib.Path(__file__).resolve().parents[1].parent / "shared" / "data"
+from conftest import shared_data_path
+
+DATA = shared_data_path()  # ../shared/data, or $ROUGH_SHARED/data
 X3PIO = DATA / "x3pio"
 needs_shared = pytest.mark.skipif(not X3PIO.is_dir(), reason="needs ../shared/data")
 TYPES = {"I": "<i2", "L": "<i4", "F": "<f4", "D": "<f8"}

@@ -419,7 +419,7 @@ def test_a_failed_write_leaves_no_file(tmp_path, monkeypatch):
         st.tuples(st.integers(2, 40)),
         st.tuples(st.integers(2, 12), st.integers(2, 12)),
     ),
-    values=st.lists(st.floats(allow_nan=True, allow_infinity=False, width=64), min_size=1, max_size=64),
+    values=st.lists(st.one_of(st.floats(-1e5, 1e5), st.just(float("nan"))), min_size=1, max_size=64),
     pieces=st.lists(st.integers(1, 300), min_size=1, max_size=5),
 )
 def test_round_trip_through_a_trickling_stream_is_exact(small_steps, shape, values, pieces):
@@ -441,7 +441,7 @@ def test_round_trip_through_a_trickling_stream_is_exact(small_steps, shape, valu
 def test_pipeline_of_stages_is_exact_and_refuses_damage(tmp_path):
     surface = map_with_holes((300, 200))
     heights = surface.heights.copy()
-    heights[7, 7], heights[8, 8], heights[9, 9] = -0.0, 5e-324, 1e300
+    heights[7, 7], heights[8, 8], heights[9, 9] = -0.0, 5e-324, 1e5  # 1e5 m: the largest height rough reads
     surface = Surface(heights, surface.spacing, metadata=surface.metadata)
     surface.write(tmp_path / "in.x3p")
     command = [sys.executable, "-m", "rough", "convert"]
@@ -463,11 +463,13 @@ def test_pipeline_of_stages_is_exact_and_refuses_damage(tmp_path):
 
 
 def test_the_shared_checks_take_one_pass_and_still_catch_everything(caplog):
-    """rough.io's checks after every reader: a sum says whether any height is NaN or
-    infinite; only then (or when the sum overflows) are the heights looked at in full."""
-    huge = np.full((3, 4), 1.5e308)  # finite, but their sum is not
-    np.testing.assert_array_equal(read_bytes(received(written(Surface(huge, (1e-6, 1e-6))))).heights, huge)
+    """rough.io's checks after every reader: a sum of squares says whether any height is
+    NaN, infinite or beyond ±100 km; only then are the heights looked at in full."""
+    edge = np.full((3, 4), 1e5)  # at the limit: their squares pass the quick bound, the full look reads them
+    np.testing.assert_array_equal(read_bytes(received(written(Surface(edge, (1e-6, 1e-6))))).heights, edge)
     assert "infinite" not in caplog.text
+    with pytest.raises(FormatError, match="a height of 1.5e\\+308 m .* is beyond ±100 km"):
+        read_bytes(received(written(Surface(np.full((3, 4), 1.5e308), (1e-6, 1e-6)))))
     spiky = GRID.copy()
     spiky[1, 1] = np.inf
     again = read_bytes(received(written(Surface(spiky, (1e-6, 1e-6)))))

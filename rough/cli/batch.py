@@ -34,6 +34,8 @@ def run_each(work, names, options):
         _check_side_files(side)
         if "output" in options:
             options["output"].check_directory(names)
+    elif "output" in options:
+        options["output"].check()
     status = 0
     for name in _progress(names, many):
         named = {**options, **{key: stem_name(path, name) for key, path in side.items()}}

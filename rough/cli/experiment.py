@@ -5,7 +5,7 @@ import math
 import click
 
 from .haptics import SPEED, TIME, haptic_options
-from .options import LENGTH, plot_option, report_format
+from .options import LENGTH, LENGTHS, FloatRange, plot_option, report_format
 from .report import Report, collected_warnings, emit
 
 
@@ -40,12 +40,10 @@ def experiment():
     metavar="D,RQ",
     help="A reference surface, e.g. 1.275,0.2781mm (repeat for several sets).",
 )
-@click.option(
-    "--dimension-step", type=click.FloatRange(0, 0.5, min_open=True), help="Neighbours' D offset (default 0.075)."
-)
+@click.option("--dimension-step", type=FloatRange(0, 0.5, min_open=True), help="Neighbours' D offset (default 0.075).")
 @click.option(
     "--rq-factor",
-    type=click.FloatRange(1, 10, min_open=True),
+    type=FloatRange(1, 10, min_open=True),
     help="Neighbours' Rq ratio (default 0.3502/0.2781 = 1.2593).",
 )
 @click.option(
@@ -90,15 +88,25 @@ def design(
     surfaces, sets = grid_design(
         chosen, dimension_step or defaults["dimension_step"], rq_factor or defaults["rq_factor"]
     )
+    length = length or defaults["length"]
+    spacings = {"--synthesis-spacing": synthesis_spacing or defaults["synthesis_spacing"]}
+    spacings["--spacing"] = spacing or defaults["spacing"]
+    for flag, step in spacings.items():
+        if round(length / step) < 2:
+            from ..units import format_length
+
+            raise InputError(
+                f"--length {format_length(length)} holds fewer than two samples at {flag} {format_length(step)}"
+            )
     result = write_study(
         study,
         surfaces,
         sets,
         subject_ids(subjects or defaults["subjects"]),
         seed,
-        length or defaults["length"],
-        synthesis_spacing or defaults["synthesis_spacing"],
-        spacing or defaults["spacing"],
+        length,
+        spacings["--synthesis-spacing"],
+        spacings["--spacing"],
         preset,
     )
     rows = [
@@ -140,8 +148,8 @@ def _reference(text):
     if not 1 < dimension < 2:
         raise InputError(f"--reference {text!r}: a profile's D lies between 1 and 2")
     rq = parse_length(parts[1])
-    if rq <= 0:
-        raise InputError(f"--reference {text!r}: Rq must be positive")
+    if not LENGTHS[0] <= rq <= LENGTHS[1]:
+        raise InputError(f"--reference {text!r}: Rq must lie between 1 pm and 10000 km")
     return dimension, rq
 
 

@@ -5,7 +5,7 @@ import dataclasses
 
 import click
 
-from .options import LENGTH, POSITION, RATIO, RATIOS, crop_option, plot_option, report_format, surface_input
+from .options import LENGTH, POSITION, RATIO, RATIOS, FloatRange, crop_option, plot_option, report_format, surface_input
 from .report import Report, on_stdout, shown
 
 
@@ -25,9 +25,8 @@ from .report import Report, on_stdout, shown
 @click.option(
     "--sampling-lengths",
     type=click.IntRange(1, 1000),
-    default=5,
-    show_default=True,
-    help="Sampling lengths that Rp, Rv and Rz are averaged over.",
+    help="Sampling lengths that Rp, Rv and Rz are averaged over: with --cutoff, lengths of λc in the middle of "
+    "the profile (default: every whole one it holds, ISO 4288); without, equal sections (default 5).",
 )
 @click.option(
     "--slope",
@@ -45,6 +44,14 @@ from .report import Report, on_stdout, shown
 )
 @click.option(
     "--along", type=click.Choice(["x", "y"]), help="Maps: profile parameters of the map's profiles along x or y."
+)
+@click.option(
+    "--acf",
+    type=click.Choice(["iso", "per-lag"]),
+    default="iso",
+    show_default=True,
+    help="Maps: the autocorrelation of Sal and Str: ISO 25178-2's (products summed over the overlap, over the "
+    "sum of squares) or the mean product per lag (surfalize's).",
 )
 @click.option(
     "--detect-cutoff",
@@ -105,7 +112,7 @@ from .report import Report, on_stdout, shown
 )
 @click.option(
     "--pruning",
-    type=click.FloatRange(0, 100, max_open=True),
+    type=FloatRange(0, 100, max_open=True),
     default=5.0,
     show_default=True,
     help="Maps: Wolf pruning of hills and dales lower than this percentage of Sz.",
@@ -138,6 +145,7 @@ def features(
     slope,
     jrc_spacing,
     along,
+    acf,
     detect_cutoff,
     detect_mode,
     polarity,
@@ -155,8 +163,8 @@ def features(
     """Parameters of INPUT (default: standard input) computed on the data as given,
     with only the mean of the valid points removed (pipe through `rough detrend`
     first to remove form, or give --cutoff for the roughness). Profiles: Ra, Rq,
-    Rsk, Rku, Rdq, Rt over the evaluation length; Rp, Rv, Rz per sampling length,
-    averaged; RSm; peak density (peaks crossing ±5 % of Rz about the mean line, per
+    Rsk, Rku, Rdq, Rt over the evaluation length; Rp, Rv, Rz per sampling length
+    (λc with --cutoff, ISO 4288), averaged; RSm; peak density (peaks crossing ±5 % of Rz about the mean line, per
     mm); Z2 and the Tse–Cruden JRC at --jrc-spacing; the material-ratio parameters
     Rmr(c), Rmc(mr), Rδc, Rk, Rpk, Rvk, Mr1, Mr2, A1, A2 (ISO 13565-2) and Rpq, Rvq,
     Rmq (ISO 13565-3); and the slides' feature detection. Maps: Sa, Sq, Ssk, Sku,
@@ -177,18 +185,34 @@ def features(
     """
     from .. import metrology
     from ..io.atomic import atomic_output
+    from ..metrology.segmentation import undefined_reasons
 
     report = not on_stdout(list=feature_list, plot=plot, segments=segments)
     evaluated = surface if cutoff is None else metrology.split(surface, cutoff, "roughness", ends)
     settings = Settings(
-        cutoff, sampling_lengths, slope, jrc_spacing, along, material_height, material_ratio, dc_ratios, volume_ratios
+        cutoff,
+        sampling_lengths,
+        slope,
+        jrc_spacing,
+        along,
+        material_height,
+        material_ratio,
+        dc_ratios,
+        volume_ratios,
+        acf,
     )
     if segments and (surface.is_profile or along):
         from ..errors import InputError
 
         raise InputError("--segments needs a map evaluated as a map, without --along (a profile's features: --list)")
     values = metrology.parameters(
-        evaluated, sampling_lengths=sampling_lengths, slope=slope, along=along, jrc_spacing=jrc_spacing
+        evaluated,
+        sampling_lengths=sampling_lengths,
+        slope=slope,
+        along=along,
+        jrc_spacing=jrc_spacing,
+        sampling_length=cutoff,
+        acf=acf,
     )
     functional = metrology.functional_parameters(
         evaluated,
@@ -203,7 +227,7 @@ def features(
     if not (surface.is_profile or along):
         hills, dales = (metrology.segment(evaluated, kind, pruning) for kind in ("hills", "dales"))
         featured = metrology.motif_parameters(evaluated, hills, dales, edge_features)
-        metrology.announce_undefined(featured)
+        metrology.announce_undefined(featured, undefined_reasons(hills, dales, edge_features))
         segmentation = _segmentation(pruning, edge_features, values["Sz"])
         rows += _value_rows(featured, metrology.FEATURE, {"Spd": segmentation["text"]})
         document.update(featured)
@@ -260,6 +284,7 @@ class Settings:
     ratio: float
     dc_ratios: tuple
     volume_ratios: tuple
+    acf: str
 
 
 def _parameter_rows(surface, values, functional, settings):
@@ -276,12 +301,12 @@ def _parameter_rows(surface, values, functional, settings):
     if settings.along:
         basis += f", profiles along {settings.along}"
     profile = surface.is_profile or settings.along
+    sections = _sampling(surface, settings) if profile else None
     evaluation = {
         "points": surface.heights.size,
         "valid_points": valid,
         "size": list(surface.size),
         "basis": basis,
-        "sampling_lengths": settings.sampling_lengths,
         "slope": settings.slope,
         "jrc_spacing": settings.jrc_spacing,
         "cutoff": settings.cutoff,
@@ -292,11 +317,17 @@ def _parameter_rows(surface, values, functional, settings):
             "volume_ratios": list(settings.volume_ratios),
         },
     }
+    if profile:
+        evaluation["sampling_lengths"] = len(sections)
+        evaluation["sampling_length"] = _sampling_length(surface, settings, sections)
+    else:
+        evaluation["acf"] = settings.acf
     ratio_units = {"height": "m", "ratio": "%", "dc_ratios": "%", "volume_ratios": "%"}
     units = {"points": "points", "valid_points": "points", "size": "m", "jrc_spacing": "m", "cutoff": "m"}
+    units["sampling_length"] = "m"
     units |= {"material_ratio": ratio_units, "segmentation": {"pruning": "%", "threshold": "m"}}
     rows = [("evaluation", evaluation, units, f"{extent}, {valid} of {surface.heights.size} points valid; {basis}")]
-    notes = _notes(surface, values, settings)
+    notes = _notes(surface, values, settings, sections)
     rows += _value_rows(values, metrology.PROFILE if profile else metrology.AREAL, notes)
     rows += _value_rows(functional, metrology.PROFILE_FUNCTIONAL if profile else metrology.AREAL_FUNCTIONAL, notes)
     if "JRC" in values and not 0 <= values["JRC"] <= 20:
@@ -321,7 +352,15 @@ def _bracket(note):
     return f" ({note})" if note else ""
 
 
-def _notes(surface, values, settings):
+def _sampling(surface, settings):
+    """The sampling lengths of the profiles evaluated, as index ranges."""
+    from ..metrology.parameters import sampling_sections
+
+    axis = 1 if settings.along == "y" else 0
+    return sampling_sections(surface.points[axis], surface.spacing[axis], settings.cutoff, settings.sampling_lengths)
+
+
+def _notes(surface, values, settings, sections):
     from ..units import format_length
 
     c = f"c = {format_length(settings.height)} about the mean"
@@ -329,9 +368,10 @@ def _notes(surface, values, settings):
     dc = f"between {settings.dc_ratios[0]:g} % and {settings.dc_ratios[1]:g} %"
     pq = f"p = {settings.volume_ratios[0]:g} %, q = {settings.volume_ratios[1]:g} %"
     notes = {
-        "Rz": f"{settings.sampling_lengths} sampling lengths",
+        "Rz": _sampling_note(surface, settings, sections),
         "Rdq": f"{settings.slope} slope",
         "Sdq": f"{settings.slope} slope",
+        "Sal": f"{settings.acf} autocorrelation",
         "JRC": f"Z2 at {format_length(max(settings.jrc_spacing, surface.spacing[0]))} spacing",
         "Rmr": c,
         "Smr": c,
@@ -346,6 +386,24 @@ def _notes(surface, values, settings):
     if "JRC" in values and not 0 <= values["JRC"] <= 20:
         notes["JRC"] += "; outside the 0–20 range the relation was calibrated on"
     return notes
+
+
+def _sampling_length(surface, settings, sections):
+    """The sampling length in metres: λc, or the length of the equal sections."""
+    if settings.cutoff is not None:
+        return settings.cutoff
+    axis = 1 if settings.along == "y" else 0
+    return surface.points[axis] / len(sections) * surface.spacing[axis]
+
+
+def _sampling_note(surface, settings, sections):
+    from ..units import format_length
+
+    if sections is None:
+        return None
+    if settings.cutoff is None:
+        return f"{len(sections)} sampling lengths"
+    return f"{len(sections)} sampling lengths of λc = {format_length(settings.cutoff)}"
 
 
 def _segmentation(pruning, edges, sz):

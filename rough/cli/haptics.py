@@ -17,16 +17,7 @@ class PositiveQuantity(QuantityType):
     """A quantity that must be positive (and at most ``most``, if given)."""
 
     def __init__(self, kind, default_unit, most=None):
-        super().__init__(kind, default_unit)
-        self.most = most
-
-    def convert(self, value, param, ctx):
-        quantity = super().convert(value, param, ctx)
-        if quantity <= 0:
-            self.fail(f"{value!r}: must be positive", param, ctx)
-        if self.most is not None and quantity > self.most:
-            self.fail(f"{value!r}: at most {self.most:g} {self.default_unit}", param, ctx)
-        return quantity
+        super().__init__(kind, default_unit, positive=True, most=most)
 
 
 FORCE, STIFFNESS, DAMPING = (

@@ -6,13 +6,65 @@ the input-spacing option otherwise, for commands whose own ``--spacing`` is an
 output); ``surface_output`` adds ``-o/--output`` and ``-f/--format`` and hands it an
 :class:`Output` that writes a surface there; ``report_format`` adds
 ``--json``/``--tsv``. Lengths take a unit; a bare number is in mm.
+
+Every number an option takes is range-checked here, by its type: it must be finite
+(NaN and infinities refused), positive where the option says so, and of a plausible
+size for what it measures (:data:`LENGTHS`, :data:`QUANTITIES`), so that no later
+square, reciprocal or grid of points overflows, underflows or asks for more memory
+than exists. A new option gets these checks by using these types
+(:class:`FloatRange`, not click's, which lets NaN through).
 """
 
 import dataclasses
 import functools
+import math
 import sys
 
 import click
+
+#: The smallest and largest length (metres) an option takes: 1 pm (below an atom's
+#: size) and 10 000 km (a planet's elevation model, a UTM northing); zero where an
+#: option allows it.
+LENGTHS = (1e-12, 1e7)
+#: The smallest and largest sampling interval, as a surface takes (rough.surface.SPACING_RANGE).
+SPACINGS = (1e-12, 1e6)
+#: The smallest (non-zero) and largest magnitude, in SI units, of each quantity.
+QUANTITIES = {
+    "force": (1e-6, 1e4),  # 1 µN … 10 kN
+    "stiffness": (1e-3, 1e9),  # 1 N/km … 1 N/nm
+    "damping": (1e-9, 1e6),  # N·s/m
+    "mass": (1e-9, 1e3),  # 1 µg … 1 t
+    "speed": (1e-9, 1e3),  # 1 nm/s … 1 km/s
+    "time": (1e-6, 1e6),  # 1 µs … 11.6 days
+    "rate": (1e-3, 1e6),  # Hz
+}
+
+
+def _refuse_outside(type_, number, bounds, value, param, ctx, what, show, zero=False):
+    """Fail unless ``number`` is finite and ``bounds[0] <= |number| <= bounds[1]``
+    (or zero, where ``zero`` allows it)."""
+    if number == 0 and zero:
+        return number
+    if not (math.isfinite(number) and bounds[0] <= abs(number) <= bounds[1]):
+        kind = "be 0 or lie" if zero else "be positive, and lie" if number <= 0 else "lie"
+        type_.fail(f"{value!r}: {what} must {kind} between {show(bounds[0])} and {show(bounds[1])}", param, ctx)
+    return number
+
+
+def _length(metres):
+    from ..units import format_length
+
+    return format_length(metres, 6)
+
+
+class FloatRange(click.FloatRange):
+    """click's FloatRange, refusing NaN (which passes every comparison) and infinities."""
+
+    def convert(self, value, param, ctx):
+        number = super().convert(value, param, ctx)
+        if not math.isfinite(number):
+            self.fail(f"{value!r} is not a finite number", param, ctx)
+        return number
 
 
 def plot_option(help):
@@ -30,7 +82,8 @@ def plot_option(help):
 
 
 class LengthType(click.ParamType):
-    """A length with a unit (``0.1545mm``, ``30.9um``, ``2e-3m``) → metres."""
+    """A length with a unit (``0.1545mm``, ``30.9um``, ``2e-3m``) → metres; a position,
+    of either sign, up to 10 000 km from the origin."""
 
     name = "LENGTH"
 
@@ -41,41 +94,53 @@ class LengthType(click.ParamType):
         from ..units import parse_length
 
         try:
-            return parse_length(value)
+            length = parse_length(value)
         except InputError as error:
             self.fail(str(error), param, ctx)
+        return self.checked(length, value, param, ctx)
 
-
-class PositiveLengthType(LengthType):
-    """A length that must be positive (a spacing, cut-off, size, resolution …)."""
-
-    def convert(self, value, param, ctx):
-        length = super().convert(value, param, ctx)
-        if not length > 0:
-            self.fail(f"{value!r}: must be a positive length", param, ctx)
+    def checked(self, length, value, param, ctx):
+        """``length`` if it is in this type's range; a failure otherwise."""
+        if not abs(length) <= LENGTHS[1]:
+            self.fail(f"{value!r}: a position must lie within {_length(LENGTHS[1])} of the origin", param, ctx)
         return length
 
 
-class SpacingType(LengthType):
-    """``DX`` or ``DX,DY`` → a tuple of metres."""
+class PositiveLengthType(LengthType):
+    """A length that must be positive (a spacing, cut-off, size, resolution …), from
+    1 pm to 10 000 km (:data:`LENGTHS`)."""
+
+    what, bounds = "a length", LENGTHS
+
+    def checked(self, length, value, param, ctx):
+        if not length > 0:
+            self.fail(f"{value!r}: {self.what} must be positive", param, ctx)
+        return _refuse_outside(self, length, self.bounds, value, param, ctx, self.what, _length)
+
+
+class SpacingType(PositiveLengthType):
+    """``DX`` or ``DX,DY`` → a tuple of metres, each within :data:`SPACINGS`."""
 
     name = "DX[,DY]"
+    what, bounds = "a spacing", SPACINGS
 
     def convert(self, value, param, ctx):
         if isinstance(value, tuple):
             return value
-        parts = [super(SpacingType, self).convert(part, param, ctx) for part in str(value).split(",")]
-        if len(parts) > 2 or min(parts) <= 0:
+        parts = str(value).split(",")
+        if len(parts) > 2:
             self.fail(f"{value!r}: give one or two positive lengths, e.g. 1um or 1um,2um", param, ctx)
-        return tuple(parts)
+        return tuple(super(SpacingType, self).convert(part, param, ctx) for part in parts)
 
 
 class QuantityType(click.ParamType):
     """A physical quantity with a unit (``1.28N/mm``, ``20mm/s``, ``1.85g``) → SI; a
-    bare number is in ``default_unit``."""
+    bare number is in ``default_unit``. Zero (unless ``positive``) or a magnitude within
+    :data:`QUANTITIES` for its kind (and at most ``most``, if given)."""
 
-    def __init__(self, kind, default_unit):
-        self.kind, self.default_unit = kind, default_unit
+    def __init__(self, kind, default_unit, positive=False, most=None):
+        self.kind, self.default_unit, self.positive = kind, default_unit, positive
+        self.bounds = (QUANTITIES[kind][0], QUANTITIES[kind][1] if most is None else most)
         self.name = kind.upper()
 
     def convert(self, value, param, ctx):
@@ -90,14 +155,22 @@ class QuantityType(click.ParamType):
             self.fail(str(error), param, ctx)
         if quantity < 0:
             self.fail(f"{value!r}: must not be negative", param, ctx)
-        return quantity
+        what = f"a {self.kind}"
+        return _refuse_outside(self, quantity, self.bounds, value, param, ctx, what, self.show, not self.positive)
+
+    def show(self, quantity):
+        """``quantity`` (SI) in this option's unit."""
+        from ..units import format_unit
+
+        return format_unit(quantity, self.kind, 6)
 
 
-class TipType(LengthType):
+class TipType(PositiveLengthType):
     """A tip radius: a length, or a preset (``needle`` 0.05 mm, ``fingernail`` 0.5 mm,
     ``fingertip`` 8 mm) → metres."""
 
     name = "RADIUS|needle|fingernail|fingertip"
+    what = "a tip radius"
 
     def shell_complete(self, ctx, param, incomplete):
         from click.shell_completion import CompletionItem
@@ -109,10 +182,7 @@ class TipType(LengthType):
 
         if isinstance(value, str) and value.strip().lower() in PRESETS:
             return PRESETS[value.strip().lower()]
-        radius = super().convert(value, param, ctx)
-        if radius <= 0:
-            self.fail(f"{value!r}: a tip radius must be positive", param, ctx)
-        return radius
+        return super().convert(value, param, ctx)
 
 
 class CropType(click.ParamType):
@@ -158,6 +228,10 @@ class FrequencyRangeType(click.ParamType):
             self.fail(str(error), param, ctx)
         if any(end is not None and end <= 0 for end in (low, high)):
             self.fail(f"{value!r}: frequencies must be positive", param, ctx)
+        bounds = (1 / LENGTHS[1], 1 / LENGTHS[0])  # the wavelengths an option may take
+        for end in (low, high):
+            if end is not None:
+                _refuse_outside(self, end, bounds, value, param, ctx, "a frequency", lambda f: f"{f * 1e-3:.6g}/mm")
         if low is not None and high is not None and low >= high:
             self.fail(f"{value!r}: FMIN must be below FMAX, e.g. 0.05/mm:5/mm", param, ctx)
         return low, high
@@ -235,7 +309,7 @@ def model_options(command):
             ),
             click.option(
                 "--level",
-                type=click.FloatRange(0, 1, min_open=True, max_open=True),
+                type=FloatRange(0, 1, min_open=True, max_open=True),
                 default=0.01,
                 show_default=True,
                 help="Goodness-of-fit level for the automatic band (the widest band whose p reaches it).",
@@ -255,13 +329,10 @@ class RegridType(SpacingType):
         if isinstance(value, tuple):
             return value
         length, _, method = str(value).partition(":")
-        method = method.strip().lower() or "bandlimited"
+        method = method.strip().lower() or "linear"
         if method not in ("linear", "bandlimited"):
             self.fail(f"{value!r}: the method is linear or bandlimited, e.g. 0.5um:linear", param, ctx)
-        spacing = LengthType.convert(self, length, param, ctx)
-        if spacing <= 0:
-            self.fail(f"{value!r}: the spacing must be positive", param, ctx)
-        return spacing, method
+        return LengthType.convert(self, length, param, ctx), method
 
 
 def input_options(spacing_flag="--spacing", together=None):
@@ -326,7 +397,8 @@ def input_options(spacing_flag="--spacing", together=None):
                 "--regrid",
                 type=RegridType(),
                 help="Interpolate unevenly spaced data (stylus exports, irregular X3P) onto this spacing, "
-                "e.g. 0.5um (band-limited) or 0.5um:linear; recorded in the history. Without it they are refused.",
+                "e.g. 0.5um (linear: cannot ring) or 0.5um:bandlimited (for coarsening); recorded in the history. "
+                "Without it they are refused.",
             ),
         ]
         for decorator in reversed(decorators):
@@ -374,7 +446,9 @@ def surface_output(command):
 
     @functools.wraps(command)
     def wrapper(*args, output, format=None, **kwargs):
-        return command(*args, output=output if isinstance(output, Output) else Output(output, format), **kwargs)
+        output = output if isinstance(output, Output) else Output(output, format)
+        output.check()
+        return command(*args, output=output, **kwargs)
 
     wrapper = click.option(
         "-f",
@@ -439,6 +513,11 @@ class Output:
         extension = formats()[format_name].extensions[0]
         return Output(os.path.join(self.path, stem_name("{stem}", name) + extension), format_name)
 
+    def check(self):
+        """Refuse, before any work, an output file whose format cannot be told; the
+        format (None for a directory, whose files' format is chosen per input)."""
+        return None if self.is_directory else self.format
+
     @property
     def format(self):
         from ..errors import InputError
@@ -455,12 +534,13 @@ class Output:
     def write(self, surface):
         from ..errors import InputError
         from ..io import BINARY, write
-        from ..io.atomic import atomic_output, standard_output
+        from ..io.atomic import atomic_output, names_a_terminal, standard_output
 
-        if self.path == "-" and self.format in BINARY and standard_output() and sys.stdout.isatty():
+        on_terminal = standard_output() and sys.stdout.isatty() if self.path == "-" else names_a_terminal(self.path)
+        if self.format in BINARY and on_terminal:
             raise InputError(
                 f"refusing to write binary {self.format.upper()} to a terminal: use -o FILE, a pipe, or -f tsv",
-                filename="-",
+                filename=self.path,
             )
         if self.path != "-":
             write(surface, self.path, format=self.format)

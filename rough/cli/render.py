@@ -6,7 +6,7 @@ import math
 import click
 
 from .haptics import DAMPING, FORCE, MASS, SPEED, STIFFNESS, TIME, haptic_options
-from .options import CROP, POSITION, TIP, input_options, plot_option, report_format
+from .options import CROP, POSITION, TIP, FloatRange, input_options, plot_option, report_format
 from .report import Report, on_stdout, shown
 
 
@@ -44,7 +44,7 @@ from .report import Report, on_stdout, shown
 )
 @click.option(
     "--direction",
-    type=click.FloatRange(-360, 360),
+    type=FloatRange(-360, 360),
     default=0.0,
     show_default=True,
     metavar="DEGREES",

@@ -2,7 +2,7 @@
 
 import click
 
-from .options import BAND, LENGTH, crop_option, model_options, plot_option, report_format, surface_input
+from .options import BAND, LENGTH, FloatRange, crop_option, model_options, plot_option, report_format, surface_input
 from .report import Report, on_stdout, shown
 
 
@@ -11,14 +11,14 @@ from .report import Report, on_stdout, shown
 @crop_option
 @click.option(
     "--step",
-    type=click.FloatRange(1, 90),
+    type=FloatRange(1, 90),
     default=10.0,
     show_default=True,
     help="Angle between sector centres (degrees; must divide 180).",
 )
 @click.option(
     "--width",
-    type=click.FloatRange(1, 180),
+    type=FloatRange(1, 180),
     help="Sector width in degrees (default: the step, sectors not overlapping).",
 )
 @click.option("--band", type=BAND, help="Fit band FMIN:FMAX in cycles per length (bare numbers per mm).")

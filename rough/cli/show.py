@@ -81,12 +81,14 @@ def show(surface, input, figure_file, figure_format, title, hillshade, order, co
     """Draw the profile or map in INPUT (default: standard input), for a quick look.
 
     A map is drawn as a height colour map at equal physical aspect (a 10 mm × 0.5 mm
-    scan is a wide strip, and the figure takes its shape), with x and y in a length
-    unit chosen from the extent, a colour bar in a unit chosen from the height range
-    (clipped, with arrows, when a few spikes would wash out the rest), a scale bar,
-    and invalid (NaN) points in light grey, counted in a legend. A profile is drawn
-    as height against position, with its invalid runs as shaded gaps. The title is
-    the input's file name; the line under it gives the points, size and spacing.
+    scan is a wide strip, and the figure takes its shape), y upwards (row 0 at the
+    bottom: a DEM is north up, and directions read as rose and Std give them), with
+    x and y in a length unit chosen from the extent, a colour bar in a unit chosen
+    from the height range (clipped, with arrows, when a few spikes would wash out the
+    rest), a scale bar, and invalid (NaN) points in light grey, counted in a legend.
+    A profile is drawn as height against position, with its invalid runs as shaded
+    gaps. The title is the input's file name; the line under it gives the points,
+    size and spacing.
     Heights are as in the file unless --order removes a polynomial form.
 
     \b

@@ -2,7 +2,7 @@
 
 import click
 
-from .options import LENGTH, surface_output
+from .options import LENGTH, FloatRange, surface_output
 
 
 class SizeType(click.ParamType):
@@ -32,11 +32,13 @@ class AnisotropyType(click.ParamType):
         parts = str(value).split(",")
         if len(parts) != 5:
             self.fail(f"{value!r}: give Ds1,C1,Ds2,C2,ANGLE, e.g. 2.2,1um,2.4,3um,30", param, ctx)
-        try:
-            ds1, ds2, angle = float(parts[0]), float(parts[2]), math.radians(float(parts[4]))
-        except ValueError:
-            self.fail(f"{value!r}: Ds1, Ds2 and ANGLE (degrees) must be numbers", param, ctx)
+        ds1, ds2 = (SURFACE_DIMENSION.convert(part, param, ctx) for part in parts[0:3:2])
+        angle = math.radians(ANGLE.convert(parts[4], param, ctx))
         return ds1, LENGTH.convert(parts[1], param, ctx), ds2, LENGTH.convert(parts[3], param, ctx), angle
+
+
+SURFACE_DIMENSION = FloatRange(2, 3, min_open=True, max_open=True)
+ANGLE = FloatRange(-360, 360)
 
 
 @click.command(short_help="Synthesise a fractal profile or map with chosen D and C or Rq.")
@@ -52,7 +54,7 @@ class AnisotropyType(click.ParamType):
 )
 @click.option(
     "--dimension",
-    type=float,
+    type=FloatRange(1, 3, min_open=True, max_open=True),
     help="Fractal dimension: D in (1, 2) for a profile, the surface dimension Ds in (2, 3) for a map.",
 )
 @click.option(

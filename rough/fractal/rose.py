@@ -258,6 +258,7 @@ def rose(
     resolution = resolution or min(surface.spacing)
     options = Options(noise, rolloff, level)
     frequency_step, low, high = map_band(surface, band, sampling)
+    high = min(high, math.hypot(0.5 / surface.spacing[0], 0.5 / surface.spacing[1]))  # no ring lies beyond the corner
     from scipy import fft
 
     from ..progress import progress

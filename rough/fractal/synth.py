@@ -29,7 +29,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..progress import progress
-from ..surface import Surface, Units, check_size
+from ..surface import HEIGHT_LIMIT, Surface, Units, check_size
 from . import model
 
 log = logging.getLogger("rough")
@@ -80,9 +80,10 @@ def synthesize_profile(points, spacing, dimension, amplitude=None, rq=None, reso
     ------
     rough.InputError
         For D outside (1, 2), both or neither of ``amplitude`` and ``rq``, an
-        ``amplitude``, ``rq`` or ``resolution`` that is not positive, or more points
-        than rough's limit (2²⁸). ``points`` and ``spacing`` are not checked: give
-        at least two points and a positive spacing.
+        ``amplitude``, ``rq`` or ``resolution`` that is not positive, more points
+        than rough's limit (2²⁸), or heights beyond ±100 km (HEIGHT_LIMIT).
+        ``points`` and ``spacing`` are not checked: give at least two points and a
+        positive spacing.
 
     See Also
     --------
@@ -195,7 +196,8 @@ def synthesize_map(
     rough.InputError
         For Ds outside (2, 3), both or neither of ``amplitude`` and ``rq``,
         ``anisotropy`` with ``rq``, an ``amplitude``, ``rq`` or ``resolution`` that
-        is not positive, or more points than rough's limit (16384 × 16384).
+        is not positive, more points than rough's limit (16384 × 16384), or heights
+        beyond ±100 km (HEIGHT_LIMIT).
         ``points`` and ``spacing`` are not checked.
 
     See Also
@@ -323,6 +325,7 @@ def synthesize_fragments(
     beta = model.profile_exponent(dimension)
     resolution = _amplitude_choice(amplitude, rq, resolution, spacing)
     check_size((points,), "the profile")
+    check_size((fragment,), "a fragment")
     seed = _seed(seed)
     generator = np.random.Generator(np.random.PCG64(np.random.SeedSequence(seed)))
     scale = model.prefactor(amplitude or 1.0, dimension, resolution)
@@ -534,6 +537,16 @@ def _parameters(**values):
 
 
 def _surface(heights, spacing, parameters):
+    """The synthesised surface; an InputError when its heights reach beyond
+    ±HEIGHT_LIMIT, where rough refuses to read them back."""
+    reach = max(-float(heights.min()), float(heights.max()))
+    if not reach <= HEIGHT_LIMIT:
+        from ..units import format_length
+
+        raise InputError(
+            f"the synthesised heights reach {format_length(reach)}, beyond ±{format_length(HEIGHT_LIMIT)}, "
+            "which no surface reaches and rough does not read back: give a smaller --rq or --amplitude"
+        )
     surface = Surface(heights, spacing, units=Units("m", "m"), metadata={"title": _title(parameters, len(spacing))})
     return surface.derive("synth", parameters)
 

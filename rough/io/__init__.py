@@ -23,9 +23,11 @@ import contextlib
 import dataclasses
 import io
 import logging
+import math
 import os
 import struct
 import sys
+import threading
 import tokenize
 import xml.etree.ElementTree
 import zipfile
@@ -34,6 +36,8 @@ import zlib
 import numpy as np
 
 from ..errors import FormatError, InputError
+from ..surface import HEIGHT_LIMIT, RELIEF_LIMIT
+from ..units import format_length
 from . import limits, registry
 from .regrid import option as regrid_option
 
@@ -120,8 +124,9 @@ def read(source, *, spacing=None, unit=None, verify=True, channel=None, layer=No
         elevation model larger than memory can be analysed piece by piece; other
         formats are read whole and cropped.
     regrid : float or (float, str), optional
-        A spacing in metres, and optionally the method (``"bandlimited"``, the
-        default, or ``"linear"``), for unevenly spaced profiles (stylus exports,
+        A spacing in metres, and optionally the method (``"linear"``, the default,
+        which cannot ring, or ``"bandlimited"`` for coarsening), for unevenly spaced
+        profiles (stylus exports,
         x z text): they are interpolated onto that grid and the step is recorded in
         the history. Without it such data are refused.
 
@@ -174,15 +179,37 @@ def read(source, *, spacing=None, unit=None, verify=True, channel=None, layer=No
         regrid=regrid,
     )
     name = _name(source)
-    with _named(name):
-        surface = _read_path(name, options) if _is_path(source) else None
-    if surface is None:
-        name, data = _slurp(source)
+    with _warnings_held():
         with _named(name):
-            surface = read_bytes(data, options, name=name)
+            surface = _read_path(name, options) if _is_path(source) else None
+        if surface is None:
+            name, data = _slurp(source)
+            with _named(name):
+                surface = read_bytes(data, options, name=name)
     surface.metadata.setdefault("source", name)
     log.info("read %s: %s, %s points", name, describe(surface.source_format), " × ".join(map(str, surface.points)))
     return surface
+
+
+@contextlib.contextmanager
+def _warnings_held():
+    """Hold this thread's log records while a file is read: given out once it is read,
+    dropped when it is refused, whose one line says what matters."""
+    held, thread = [], threading.get_ident()
+
+    def hold(record):
+        if record.thread != thread:
+            return True
+        held.append(record)
+        return False
+
+    log.addFilter(hold)
+    try:
+        yield
+    finally:
+        log.removeFilter(hold)
+    for record in held:
+        log.handle(record)
 
 
 @contextlib.contextmanager
@@ -244,12 +271,8 @@ def _parse(data, options, name=None):
             raise FormatError(f"gzip nested more than {limits.MAX_GZIP_LAYERS} deep; refusing")
         data = gunzip(data, packed)
     format_name = sniff(data, name)
-    text_cap = limits.cap("MAX_TEXT_BYTES")
-    if format_name == "tsv" and len(data) > text_cap:
-        raise FormatError(
-            f"{limits.human(len(data))} of text is more than rough parses ({limits.human(text_cap)}); "
-            "convert it to X3P or NPY, or set ROUGH_MAX_TEXT_BYTES to raise the cap"
-        )
+    if format_name == "tsv" and len(data) > limits.cap("MAX_TEXT_BYTES"):
+        raise limits.too_much_text(len(data))
     with np.errstate(all="ignore"):
         surface = _module(format_name).read(data, options)
     return _checked(surface, format_name, options)
@@ -257,11 +280,12 @@ def _parse(data, options, name=None):
 
 def _checked(surface, format_name, options, windowed=False):
     """The checks and options every format shares: infinite heights → NaN, at least
-    two points and one valid, ``options.spacing`` and ``options.window``."""
+    two points and one valid, heights within ±:data:`~rough.surface.HEIGHT_LIMIT`,
+    ``options.spacing`` and ``options.window``."""
     surface.source_format = format_name
-    with np.errstate(over="ignore", invalid="ignore"):
-        finite = bool(np.isfinite(surface.heights.sum()))  # one pass, no temporary; an overflow checks in full
-    if not finite and not np.isfinite(surface.heights).all():
+    squares = _sum_of_squares(surface.heights)  # one pass: NaN, infinity or a huge height all show in it
+    clean = squares <= HEIGHT_LIMIT**2
+    if not clean and not np.isfinite(surface.heights).all():
         infinite = np.isinf(surface.heights)
         if infinite.any():
             first = np.unravel_index(np.argmax(infinite), infinite.shape)[::-1]
@@ -273,24 +297,61 @@ def _checked(surface, format_name, options, windowed=False):
             surface.heights = np.where(infinite, np.nan, surface.heights)
     if surface.heights.size < 2:
         raise FormatError(f"holds {surface.heights.size} point; a surface needs at least two points")
-    if not finite and np.isnan(surface.heights).all():
+    if not clean and np.isnan(surface.heights).all():
         raise FormatError(f"holds no valid points (all {surface.heights.size} heights are invalid)")
     given = None if options.spacing is None else options.spacing[: surface.heights.ndim]
     if given is not None and tuple(surface.spacing) != tuple(given):
-        from ..units import format_length
-
         log.warning(
             "the spacing given, %s, overrides the file's own, %s",
             " × ".join(map(format_length, given)),
             " × ".join(map(format_length, surface.spacing)),
         )
         surface = dataclasses.replace(surface, spacing=given)
+    _plausible(surface, None if np.isnan(squares) else squares)
     if options.window is not None and not windowed:
         x, y = options.window
         if y is not None and surface.is_profile:
             raise InputError("a profile has no y range; crop it with X0:X1")
         surface = surface.crop(x, y)
     return surface
+
+
+def _sum_of_squares(heights):
+    """Σ z² in one pass without a temporary: NaN when a height is NaN, infinite when
+    one is infinite or beyond 1e154 m."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        if heights.flags.c_contiguous:
+            flat = heights.reshape(-1)
+            return float(np.dot(flat, flat))
+        return float(sum(np.dot(row, row) for row in np.atleast_2d(heights)))
+
+
+def _plausible(surface, squares):
+    """Refuse heights beyond ±HEIGHT_LIMIT (no surface reaches them: the data are
+    damaged, or their unit is wrong) and warn of heights spanning more than
+    RELIEF_LIMIT times the surface's width. ``squares`` is Σ z² (None with NaN
+    heights), which spares a look at every height when it is small enough."""
+    heights, unit = surface.heights, surface.units.z
+    width = max(surface.size)
+    if squares is not None and squares <= HEIGHT_LIMIT**2 and 2 * math.sqrt(squares) <= RELIEF_LIMIT * width:
+        return  # every |z| is at most √Σz²: within the limit, and the span within twice that
+    low, high = np.nanmin(heights), np.nanmax(heights)
+    if max(-low, high) > HEIGHT_LIMIT:
+        worst = low if -low > high else high
+        point = np.unravel_index(np.argmax(heights == worst), heights.shape)[::-1]
+        raise FormatError(
+            f"a height of {worst:.6g} m (at point {', '.join(map(str, point))}) is beyond "
+            f"±{format_length(HEIGHT_LIMIT)}, which no surface reaches: the data are damaged, "
+            f"or their unit ({unit}) is wrong"
+        )
+    if high - low > RELIEF_LIMIT * width:
+        log.warning(
+            "the heights span %s, %.3g times the surface's %s width: is their unit (%s) right?",
+            format_length(high - low),
+            (high - low) / width,
+            format_length(width),
+            unit,
+        )
 
 
 def sniff(data, name=None):
@@ -400,17 +461,22 @@ def format_for_path(path):
 
 def gunzip(data, packed=None):
     """Unpack gzip data, every member of it (``cat a.gz b.gz``), in chunks: refused
-    past the caps of :mod:`rough.io.limits`, counted against ``packed`` bytes (the
-    size of the file as given, for nested gzip)."""
+    past the caps of :mod:`rough.io.limits` (MAX_TEXT_BYTES once the first bytes
+    show text), counted against ``packed`` bytes (the size of the file as given, for
+    nested gzip)."""
     budget = limits.Budget(packed or len(data), "gzip data")
-    parts, pending = [], bytes(data)
+    parts, pending, looked = [], bytes(data), False
     while pending:
         unpacker = zlib.decompressobj(wbits=31)
         while pending and not unpacker.eof:
             part = unpacker.decompress(pending, min(limits.CHUNK << 4, budget.room()))
             pending = unpacker.unconsumed_tail
-            budget.add(len(part))
             parts.append(part)
+            if not looked and (budget.total + len(part) >= registry.HEAD or not pending):
+                looked = True
+                if _is_text(b"".join(parts)[: registry.HEAD]):
+                    budget.holds_text()  # text is capped as it unpacks, not once unpacked
+            budget.add(len(part))
         if not unpacker.eof:
             raise FormatError("truncated gzip data")
         pending = unpacker.unused_data
@@ -445,12 +511,12 @@ def _slurp(source):
         return "<bytes>", source
     if source == "-" or source is sys.stdin:
         widen_pipe(sys.stdin)
-        return "<stdin>", limits.read_capped(sys.stdin.buffer, "<stdin>")
+        return "<stdin>", limits.read_capped(sys.stdin.buffer, "<stdin>", _is_text)
     if isinstance(source, (str, os.PathLike)):
         name = os.fspath(source)
         try:
             with open(name, "rb") as stream:
-                return name, limits.read_capped(stream, name)
+                return name, limits.read_capped(stream, name, lambda head: _is_text(head, name))
         except FileNotFoundError:
             raise InputError(f"{name}: no such file") from None
         except IsADirectoryError:
@@ -459,8 +525,17 @@ def _slurp(source):
             raise InputError(f"{name}: permission denied") from None
     if isinstance(source, io.IOBase) or hasattr(source, "read"):
         name = getattr(source, "name", "<stream>")
-        return name, limits.read_capped(source, name)
+        return name, limits.read_capped(source, name, _is_text)
     raise InputError(f"cannot read a surface from {type(source).__name__}")
+
+
+def _is_text(head, name=None):
+    """Whether input starting with ``head`` is read as text (and so capped at
+    MAX_TEXT_BYTES while it arrives); gzip data are capped once unpacked."""
+    try:
+        return bytes(head[:2]) != GZIP_MAGIC and sniff(head, name) == "tsv"
+    except InputError:
+        return False
 
 
 def widen_pipe(stream, size=1 << 20):

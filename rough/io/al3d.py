@@ -35,12 +35,27 @@ def read(data, options):
     stride = (cols * 4 + 7) // 8 * 8
     if offset + (rows - 1) * stride + cols * 4 > len(data):
         raise FormatError(f"AL3D depth image of {cols}×{rows} points runs past the end of the file")
+    _check_length(data, tags, offset + rows * stride, rows, cols)
     depth = np.ndarray((rows, cols), "<f4", data, offset, (stride, 4)).astype(np.float64)
     invalid = _number(tags, "InvalidPixelValue", default=np.nan)
     depth[(depth == np.float32(invalid)) | ~np.isfinite(depth)] = np.nan
     spacing = (_length(tags, "PixelSizeXMeter"), _length(tags, "PixelSizeYMeter"))
     metadata = {"instrument": tags["CreatingApplication"]} if tags.get("CreatingApplication") else {}
     return Surface(depth, spacing, metadata=metadata)
+
+
+def _check_length(data, tags, depth_end, rows, cols):
+    """The file ends with the depth image or, when there is one, with the texture
+    (NumberOfPlanes byte planes at TextureImageOffset, rows padded to 8 bytes): bytes put
+    in before the depth image, or taken from before it, move it off its offset."""
+    texture = _count(tags, "TextureImageOffset", allow_zero=True) if "TextureImageOffset" in tags else 0
+    planes = _count(tags, "NumberOfPlanes", allow_zero=True) if texture else 0
+    if planes:
+        ends = (texture + planes * rows * ((cols + 7) // 8 * 8),)
+    else:
+        ends = (depth_end, depth_end - (-cols * 4) % 8)  # the last row padded, or not
+    if len(data) not in ends:
+        raise FormatError(f"AL3D header describes a file of {ends[0]:,} bytes; this one has {len(data):,}")
 
 
 def _header(data):

@@ -4,12 +4,12 @@ A text header of ``key = value`` lines (``%`` and ``#`` start comments) opens th
 ``bcrstm`` (int16 data) or ``bcrf`` (float32 data), each also as ``…_unicode`` with a UTF-16LE header.
 The header is 2048 characters long unless ``headersize`` says otherwise (characters, so twice as many
 bytes in UTF-16). Then ``xpixels`` × ``ypixels`` values follow, row by row, little-endian when
-``intelmode = 1``. ``xlength``/``ylength`` are the scan size in ``xunit``/``yunit`` (default nm),
-``xoffset``/``yoffset`` its position (the origin here). Heights are in ``zunit`` (default nm), int16 values
-times ``bit2nm``; invalid points are int16 32767 or float values above 1.7e38 (``voidpixels``). Rows are
-kept as stored (Gwyddion and SurfaceTopography agree). Facts from Gwyddion's ``bcrfile.c`` and
-SurfaceTopography's ``BCR.py``; Gwyddion also shifts the heights so that their minimum is ``zmin``, which is
-not done here.
+``intelmode = 1``, and end the file (a file of another length is refused). ``xlength``/``ylength`` are
+the scan size in ``xunit``/``yunit`` (default nm), ``xoffset``/``yoffset`` its position (the origin
+here). Heights are in ``zunit`` (default nm), int16 values times ``bit2nm``; invalid points are int16
+32767 or float values above 1.7e38 (``voidpixels``). Rows are kept as stored (Gwyddion and
+SurfaceTopography agree). Facts from Gwyddion's ``bcrfile.c`` and SurfaceTopography's ``BCR.py``;
+Gwyddion also shifts the heights so that their minimum is ``zmin``, which is not done here.
 """
 
 import numpy as np
@@ -44,8 +44,13 @@ def read(data, options):
     check_size((ny, nx), "the BCR image")
     order = "<" if _number(fields, "intelmode", 1) else ">"
     dtype = np.dtype(f"{order}f4" if floats else f"{order}i2")
-    if start + nx * ny * dtype.itemsize > len(data):
+    end = start + nx * ny * dtype.itemsize
+    if end > len(data):
         raise FormatError(f"BCR image of {nx}×{ny} points runs past the end of the file ({len(data)} bytes)")
+    if end < len(data):
+        raise FormatError(
+            f"BCR file holds {len(data):,} bytes, its header describes {end:,} (header and {nx}×{ny} points)"
+        )
     raw = np.ndarray((ny, nx), dtype, data, start).astype(np.float64)
     invalid = raw > FLOAT_VOID if floats else raw == INT_VOID
     xy_unit, z_unit = fields.get("xunit", "nm"), fields.get("zunit", "nm")

@@ -6,6 +6,7 @@ equipment, scanner and scan lists, then one ``\\*Ciao image list`` per channel, 
 Each image list gives ``Data offset`` and ``Data length`` (bytes from the file's start), ``Samps/line``
 (x points), ``Number of lines`` (y points), ``Bytes/pixel`` (2 or 4, little-endian signed integers),
 ``Scan Size`` (``500 500 nm``; ``~m`` is µm) and the channel's name in ``@2:Image Data: S [Height]``.
+The file ends where the last of its data blocks does; a file of another length is refused.
 
 Heights follow ``@2:Z scale: V [Sens. Zsens] (0.0050354 V/LSB) 2.910461 V``: a raw value times the hard
 value (2.910461 V) over 256^Bytes/pixel gives volts, and the soft scale ``@Sens. Zsens: V 20.82646 nm/V``
@@ -49,6 +50,7 @@ def read(data, options):
     images = [_image(fields, scales, len(data), number) for number, fields in _images(sections)]
     if not images:
         raise FormatError("Nanoscope file holds no image (no Ciao image list)")
+    _check_length(sections, len(data))
     names = [image["name"] for image in images]
     index = choose_channel(names, options.channel, _default(images))
     image = images[index]
@@ -64,6 +66,18 @@ def read(data, options):
     if image["direction"]:
         metadata["di_line_direction"] = image["direction"]
     return Surface(heights, spacing, units=Units(xy=image["xy_unit"], z=image["z_unit"]), metadata=metadata)
+
+
+def _check_length(sections, file_size):
+    """FormatError unless the file ends where its last data block (``Data offset`` + ``Data length`` of
+    any list after the File list) does."""
+    ends = [
+        int(fields["Data offset"]) + int(fields["Data length"])
+        for _, fields in sections[1:]
+        if fields.get("Data offset", "").isdigit() and fields.get("Data length", "").isdigit()
+    ]
+    if ends and max(ends) != file_size:
+        raise FormatError(f"Nanoscope file holds {file_size:,} bytes, its data blocks end at byte {max(ends):,}")
 
 
 def _header_text(data):

@@ -8,10 +8,13 @@ uint16, 32: int32); 0x0067 the x and y ranges and centre offsets in metres; 0x00
 height factor (metres per count, after a uint32 range code); 0x0072 the measurement
 start as Unix time; 0x000b the single image; 0x007d, when present, several images,
 each with a uint32 data type (bit 0x4 topography, 0x2 intensity, ...), columns, rows
-and bits. Points run row by row, x fastest; the first stored row is row 0 here
-(Gwyddion flips it to the bottom). A count of 1 marks an invalid point (NaN here).
+and bits. Points run row by row, x fastest; the first stored row is the bottom line
+of the image, so rows are read in reverse (the last stored row is row 0), as
+Gwyddion's ``microprof.c`` and SurfaceTopography do. A count of 1 marks an invalid
+point (NaN here).
 Images are offered as channels; the topography is the default. Spacing is range /
-points.
+points. The header's block count walks the file to its last byte, and each image block
+holds exactly its images (as in frt-1.frt and frt-2.frt); a file that does not is refused.
 """
 
 import datetime
@@ -47,7 +50,7 @@ def read(data, options):
     default = next((i for i, image in enumerate(images) if image[0] & 0x4), 0)
     index = registry.choose_channel(names, options.channel, default)
     kind, nx, ny, bits, offset = images[index]
-    counts = np.frombuffer(data, "<u2" if bits == 16 else "<i4", nx * ny, offset).reshape(ny, nx)
+    counts = np.frombuffer(data, "<u2" if bits == 16 else "<i4", nx * ny, offset).reshape(ny, nx)[::-1]
     is_height = bool(kind & HEIGHT_KINDS)
     heights = counts * (_double(data, blocks, 0x6C, 4) if is_height else 1.0)
     heights[counts == INVALID] = np.nan
@@ -76,13 +79,15 @@ def _blocks(data):
     blocks, position = {}, 18
     for _ in range(count):
         if position + header > len(data):
-            break
+            raise FormatError(f"FRT file of {len(data):,} bytes ends before its {count} blocks do")
         block, size = struct.unpack_from(layout, data, position)
         position += header
         if position + size > len(data):
             raise FormatError(f"FRT block 0x{block:04x} of {size:,} bytes runs past the end of the file")
         blocks.setdefault(block, (position, size))
         position += size
+    if position != len(data):
+        raise FormatError(f"FRT file holds {len(data):,} bytes, its {count} blocks {position:,}")
     return blocks
 
 
@@ -97,12 +102,17 @@ def _images(data, blocks):
             kind, nx, ny, bits = struct.unpack_from("<4I", data, position)
             position = _checked_image(nx, ny, bits, position + 16, end)
             images.append((kind, nx, ny, bits, position - nx * ny * bits // 8))
+        if images and position != end:
+            raise FormatError(f"FRT block 0x007d holds {size:,} bytes, its images {position - offset:,}")
     if not images:
         if 0x66 not in blocks or 0x0B not in blocks:
             raise FormatError("FRT file holds no image (no block 0x000b or 0x007d)")
         nx, ny, bits = struct.unpack_from("<3I", data, _need(blocks, 0x66, 12))
         offset, size = blocks[0x0B]
-        _checked_image(nx, ny, bits, offset, offset + size)
+        if _checked_image(nx, ny, bits, offset, offset + size) != offset + size:
+            raise FormatError(
+                f"FRT block 0x000b holds {size:,} bytes, its {nx} × {ny} points of {bits} bits {nx * ny * bits // 8:,}"
+            )
         images.append((0x4, nx, ny, bits, offset))
     return images
 

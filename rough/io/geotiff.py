@@ -30,6 +30,8 @@ GDAL metadata items ``ROUGH_UNITS``, ``ROUGH_METADATA`` and ``ROUGH_HISTORY``.
 """
 
 import contextlib
+import ctypes
+import functools
 import logging
 import math
 import os
@@ -305,17 +307,58 @@ def _crs_for_writing(rasterio, text):
 
 @contextlib.contextmanager
 def _quiet(rasterio):
-    """No NotGeoreferencedWarning, and no traceback for a GDAL message that is not UTF-8 (a damaged tag quoted
-    in it): rasterio's logging callback fails to decode it, and Python would print that failure to stderr."""
+    """No NotGeoreferencedWarning, no libtiff message printed past GDAL, and no traceback for a GDAL message
+    that is not UTF-8 (a damaged tag quoted in it): rasterio's logging callback fails to decode it, and Python
+    would print that failure to stderr."""
+    _silence_libtiff()
     hooks = sys.unraisablehook, sys.excepthook
     sys.unraisablehook = lambda report: None if isinstance(report.exc_value, UnicodeError) else hooks[0](report)
     sys.excepthook = lambda kind, value, trace: None if issubclass(kind, UnicodeError) else hooks[1](kind, value, trace)
+    gdal, failed_reads = logging.getLogger("rasterio._env"), _FailedReads()
+    gdal.addHandler(failed_reads)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", rasterio.errors.NotGeoreferencedWarning)
             yield
     finally:
         sys.unraisablehook, sys.excepthook = hooks
+        gdal.removeHandler(failed_reads)
+    if failed_reads.messages:
+        raise FormatError(f"the file is cut short or damaged ({failed_reads.messages[0]})")
+
+
+class _FailedReads(logging.Handler):
+    """GDAL's warnings that a part of the file could not be read: libtiff then leaves out the tag (the
+    georeferencing of a file cut short) and GDAL goes on without it, which would give other numbers."""
+
+    def __init__(self):
+        super().__init__(logging.WARNING)
+        self.messages = []
+
+    def emit(self, record):
+        with contextlib.suppress(Exception):  # a message that is not UTF-8 (see _quiet)
+            message = record.getMessage()
+            if "IO error" in message:
+                self.messages.append(message[message.find("TIFF") :] if "TIFF" in message else message)
+
+
+@functools.cache
+def _silence_libtiff():
+    """Turn off the libtiff handlers that print to standard error. GDAL reports what libtiff finds through its
+    own errors, which rough words in one line; but a few libtiff calls on a damaged file (a seek past the end
+    of a BigTIFF: ``_tiffSeekProc: Invalid argument.``) reach libtiff's global handlers, which print a second
+    line. Linux only (where the loaded libraries are listed); elsewhere it does nothing."""
+    try:
+        with open("/proc/self/maps") as maps:
+            paths = {line.split()[-1] for line in maps if os.path.basename(line.split()[-1]).startswith("libtiff")}
+    except OSError:
+        return
+    for path in paths:
+        with contextlib.suppress(OSError, AttributeError):
+            library = ctypes.CDLL(path)
+            for setter in (library.TIFFSetErrorHandler, library.TIFFSetWarningHandler):
+                setter.restype, setter.argtypes = ctypes.c_void_p, [ctypes.c_void_p]
+                setter(None)
 
 
 def _one_line(error, path):

@@ -9,14 +9,18 @@ N as a ``GwyDataField`` (``xres``, ``yres``, ``xreal``, ``yreal``, ``xoff``, ``y
 and ``/N/meta`` a container of strings. Graphs are ``/N/graph/graph/M`` (``GwyGraphModel`` with ``x_unit``,
 ``y_unit`` and ``curves``, each a ``GwyGraphCurveModel`` with ``xdata`` and ``ydata``).
 
-Reading: the data fields are the channels, by title (default: the first whose title says height or topography,
-else the first); masked points are NaN (Gwyddion marks the invalid points of the files it imports with a mask; a
-user's own grain mask is read the same way). Row 0 is Gwyddion's top row, the first stored (smallest y). A field one
-row high is a profile. A file with no data field but a graph gives the first curve of the chosen graph as a profile
-(through :func:`rough.io.regrid.profile_from_points`). Units: the ``unitstr`` of ``si_unit_xy`` and ``si_unit_z``
-(``m``, or prefixed such as ``µm``; an empty lateral unit is taken as metres); a channel whose values are not lengths
-is refused. The reader is rough's own, bounded by the file's size (gwyfile's reader trusts lengths and can loop
-forever on a damaged file).
+Reading: the data fields are the channels, by title (default: the first whose title names a height, such
+as ``Height``, ``Topography``, ``Z-Axis`` or ``ZSensor``, else the first in a length unit whose title does
+not name another quantity such as deflection, amplitude, phase or friction; a file with none of these is
+refused unless ``--channel`` names a channel: a deflection in metres is not a height); masked points are NaN
+(Gwyddion marks the invalid points of the files it imports with a mask; a user's own grain mask is read the
+same way). Row 0 is Gwyddion's top row, the first stored (smallest y). A field one row high is a profile. A
+file with no data field but a graph gives the first curve of the chosen graph as a profile (through
+:func:`rough.io.regrid.profile_from_points`). Units: the ``unitstr`` of ``si_unit_xy`` and ``si_unit_z``
+(``m``, or prefixed such as ``µm``); an empty unit is ``--unit`` (Gwyddion writes fields that were never
+given a unit so), else metres for the lateral unit, and a z without unit and without ``--unit`` is refused;
+a channel whose values are not lengths is refused. The reader is rough's own, bounded by the file's size
+(gwyfile's reader trusts lengths and can loop forever on a damaged file).
 
 Writing (with gwyfile): channel 0 in metres, titled by the metadata's ``title`` less any NUL characters (GWY
 strings end at NUL; the full title travels in ``rough.metadata``), else "Height"; NaN points are
@@ -35,7 +39,7 @@ from ..errors import FormatError, InputError
 from ..surface import Surface, Units, check_size
 from ..units import metres_per
 from . import provenance, regrid
-from .registry import Format, channel_metadata, choose_channel
+from .registry import Format, channel_list, channel_metadata, choose_channel
 
 FORMAT = Format(
     "gwy",
@@ -51,7 +55,8 @@ MAGIC = b"GWYP"
 MAX_DEPTH = 32
 SCALARS = {"b": "<B", "c": "<c", "i": "<i", "q": "<q", "d": "<d"}
 ARRAYS = {"C": "<u1", "I": "<i4", "Q": "<i8", "D": "<f8"}
-HEIGHT_WORDS = ("height", "topo")
+HEIGHT = re.compile(r"height|topo|z[- ]?axis|z[- ]?sensor|^z\b", re.IGNORECASE)
+OTHER = re.compile(r"deflection|amplitude|phase|friction|force|current|error|intensity|frequency", re.IGNORECASE)
 
 
 class _Object(dict):
@@ -91,7 +96,7 @@ def _numbered(container, pattern, kind):
 def _field_surface(container, fields, options):
     keys = list(fields)
     titles = [_string(container.get(f"{key}/title")) or f"channel {key.split('/')[1]}" for key in keys]
-    index = choose_channel(titles, options.channel, _default(titles))
+    index = choose_channel(titles, options.channel) if options.channel is not None else _default(titles, fields)
     key = keys[index]
     field = fields[key]
     xres, yres = _int(field, "xres"), _int(field, "yres")
@@ -102,8 +107,8 @@ def _field_surface(container, fields, options):
         if (_int(mask, "xres"), _int(mask, "yres")) != (xres, yres):
             raise FormatError("GWY mask is not the size of its data field")
         values[_array(mask, "data", xres * yres).reshape(yres, xres) > 0] = np.nan
-    xy_unit, xy = _unit(field.get("si_unit_xy"), "lateral", default="m")
-    z_unit, z = _unit(field.get("si_unit_z"), f"channel {titles[index]!r}")
+    xy_unit, xy = _unit(field.get("si_unit_xy"), "lateral", default=options.unit or "m")
+    z_unit, z = _unit(field.get("si_unit_z"), f"channel {titles[index]!r}", default=options.unit)
     values *= z
     spacing = (_real(field, "xreal") * xy / xres, _real(field, "yreal") * xy / yres)
     origin = (_number(field, "xoff") * xy, _number(field, "yoff") * xy)
@@ -125,17 +130,30 @@ def _graph_surface(graphs, options):
     x, z = (np.asarray(curves[0].get(name), dtype=np.float64) for name in ("xdata", "ydata"))
     if x.shape != z.shape or x.ndim != 1:
         raise FormatError("GWY graph curve has x and y data of different lengths")
-    xy_unit, xy = _unit(graph.get("x_unit"), "graph x", default="m")
-    z_unit, factor = _unit(graph.get("y_unit"), f"graph {titles[index]!r}")
+    xy_unit, xy = _unit(graph.get("x_unit"), "graph x", default=options.unit or "m")
+    z_unit, factor = _unit(graph.get("y_unit"), f"graph {titles[index]!r}", default=options.unit)
     metadata = {"title": titles[index], **channel_metadata(titles, index)}
     return regrid.profile_from_points(x * xy, z * factor, options, units=Units(xy_unit, z_unit), metadata=metadata)
 
 
-def _default(titles):
+def _default(titles, fields):
+    """The first channel titled as a height, else the first in a length unit (or none) not titled as another
+    quantity; FormatError listing the channels when there is none."""
     for index, title in enumerate(titles):
-        if any(word in title.casefold() for word in HEIGHT_WORDS):
+        if HEIGHT.search(title):
             return index
-    return 0
+    for index, (title, field) in enumerate(zip(titles, fields.values())):
+        if not OTHER.search(title) and _is_length(field.get("si_unit_z")):
+            return index
+    raise FormatError(f"GWY file holds no height channel: {channel_list(titles)}; give --channel to read one anyway")
+
+
+def _is_length(unit):
+    text = (_string(unit.get("unitstr")) if isinstance(unit, _Object) else None) or ""
+    try:
+        return not text.strip() or metres_per(text.strip()) > 0
+    except InputError:
+        return False
 
 
 def _provenance(meta, title, xy_unit, z_unit):
@@ -152,7 +170,7 @@ def _unit(unit, what, default=None):
     text = _string(unit.get("unitstr")) if isinstance(unit, _Object) else None
     text = (text or "").strip() or default
     if text is None:
-        raise FormatError(f"GWY {what} values have no unit; rough reads lengths")
+        raise FormatError(f"GWY {what} values have no unit; give --unit (e.g. --unit nm) if they are lengths")
     try:
         return text, metres_per(text)
     except InputError:

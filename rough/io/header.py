@@ -1,6 +1,7 @@
 """What the headers of instrument files share: ``[section]`` blocks of key-value
 lines, numbers checked with one-line errors, length units that may not be lengths,
-the member names of a zip, and a library kept quiet while it parses a damaged file."""
+the member names of a zip, the first tags of a TIFF, and a library kept quiet while it
+parses a damaged file."""
 
 import contextlib
 import logging
@@ -105,3 +106,23 @@ def zip_names(head):
             break
         position += 30 + name_length + extra_length + packed
     return names
+
+
+def first_tiff_tags(head):
+    """``(tag, type, count, value)`` of each entry of a classic TIFF's first directory
+    that lies within ``head`` (the value as a 32-bit number in the file's byte order);
+    none when ``head`` is not a TIFF.
+
+    >>> head = b"II*\\0" + struct.pack("<IH", 8, 1) + struct.pack("<HHII", 256, 4, 1, 64)
+    >>> list(first_tiff_tags(head))
+    [(256, 4, 1, 64)]
+    """
+    order = {b"II": "<", b"MM": ">"}.get(bytes(head[:2]))
+    if order is None or len(head) < 8:
+        return
+    (directory,) = struct.unpack_from(order + "I", head, 4)
+    if directory + 2 > len(head):
+        return
+    (count,) = struct.unpack_from(order + "H", head, directory)
+    for entry in range(min(count, (len(head) - directory - 2) // 12)):
+        yield struct.unpack_from(order + "HHII", head, directory + 2 + 12 * entry)

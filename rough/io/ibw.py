@@ -10,11 +10,18 @@ wave note (``key:value`` lines) gives ``MicroscopeModel``, ``Date`` and ``Time``
 taken in the ``--unit`` unit (default metres), lateral and vertical alike. Channels whose unit is not a
 length are listed but not read. Default channel: the first whose name starts with ``Height``, else the first.
 
+The sections the binary header declares end the file, unless Asylum's thumbnails follow them: 8-bit
+previews of ``DataLength`` bytes each, then a ``key:value;`` list (from ``Version:``) that closes the
+file and gives each preview's start (``HeightTraceFileStart:2112969`` in spot_1-1000nm.ibw, the byte
+where the wave ends). The first preview must start where the wave ends, each where the one before
+ends, and the list where the last ends; other bytes after the wave are refused.
+
 Orientation: row 0 is the last line stored, as Gwyddion's ``igorfile.c`` and SurfaceTopography show it.
 """
 
 import datetime
 import io
+import re
 import struct
 
 import numpy as np
@@ -30,6 +37,8 @@ HEADER_BYTES = {1: 8 + 110, 2: 16 + 110, 3: 20 + 110, 5: 64 + 320}
 # labels and the string indices; versions 1-3 the wave (with 16 bytes of padding), note and formula.
 SECTION_SIZES = {1: (2, 1), 2: (2, 2), 3: (2, 3), 5: (4, 13)}
 BINARY_HEADER = {1: 8, 2: 16, 3: 20, 5: 64}
+THUMBNAIL_START = re.compile(rb"FileStart:(\d+);")
+THUMBNAIL_LENGTH = re.compile(rb"DataLength:(\d+);")
 
 
 def probe(head):
@@ -106,6 +115,29 @@ def _check_sizes(data):
         raise FormatError(
             f"Igor wave header declares {declared:,} bytes but the file holds {len(data):,} (damaged or truncated)"
         )
+    if declared < len(data) and not _thumbnails(data, declared):
+        raise FormatError(
+            f"Igor wave header declares {declared:,} bytes but the file holds {len(data):,}, and what follows "
+            "the wave is not Asylum's thumbnails starting where it ends"
+        )
+
+
+def _thumbnails(data, declared):
+    """Whether the bytes after the wave (from ``declared``) are Asylum's thumbnails: blocks of
+    ``DataLength`` bytes, the first at ``declared``, each after the other, then their list, which
+    starts where the last block ends."""
+    data = bytes(data)
+    listing = data.rfind(b"Version:", declared)
+    length = THUMBNAIL_LENGTH.search(data, listing) if listing >= 0 else None
+    if length is None:
+        return False
+    starts = sorted(int(start) for start in THUMBNAIL_START.findall(data, listing))
+    step = int(length.group(1))
+    return (
+        bool(starts)
+        and starts == [declared + step * number for number in range(len(starts))]
+        and starts[-1] + step == listing
+    )
 
 
 def _load(binarywave, data):

@@ -6,14 +6,19 @@ counted while they are unpacked, never unpacked first and checked after.
 
 MAX_INPUT_BYTES   bytes a file, standard input, or any unpacked stream may reach. A
                   16384² float64 map (rough's largest surface) is 2 GiB; 3 GiB
-                  leaves room for its mask and header, and still leaves a 24 GiB
-                  machine the ~6 GiB that analysing such a map takes.
+                  leaves room for its mask and header. Analysing such a map takes
+                  about ten times its heights: ``rough features`` peaked at 269 MB,
+                  519 MB and 1.46 GB on 1024², 2048² and 4096² maps (0.2 GB plus
+                  9.3 bytes per height byte), so ~19 GiB at 16384², which a 24 GiB
+                  machine just holds; ``rough info`` takes about three times.
 MAX_RATIO         unpacked bytes per packed byte. Measured heights compress 2–10:1;
                   deflate's ceiling is ~1030:1, reached only by constant data, which
                   is what a bomb holds. Checked once past RATIO_FLOOR unpacked.
-MAX_TEXT_BYTES    bytes of text parsed: text takes ~15 bytes of memory per byte to
-                  parse, so 256 MiB (a 2000² x y z map) needs ~4 GiB; larger
-                  surfaces belong in X3P or NPY.
+MAX_TEXT_BYTES    bytes of text parsed: text takes ~6 bytes of memory per byte to
+                  parse (a 23.6 MB x y z map: 187 MB at its peak), so 256 MiB (a
+                  2000² x y z map) needs ~1.6 GiB; larger surfaces belong in X3P or
+                  NPY. Applied while text arrives, once its first 64 KiB show it is
+                  text: a stream is never read past the cap.
 MAX_GZIP_LAYERS   gzip inside gzip, at most this deep.
 """
 
@@ -62,6 +67,12 @@ class Budget:
         self.packed, self.what, self.total = max(packed, 1), what, 0
         self.limit = cap("MAX_INPUT_BYTES")
         self.ratio = cap("MAX_RATIO")
+        self.text = False
+
+    def holds_text(self):
+        """From now on the bytes are text: refused past MAX_TEXT_BYTES as they unpack."""
+        self.text = True
+        self.limit = min(self.limit, cap("MAX_TEXT_BYTES"))
 
     def room(self):
         """Bytes that may still be unpacked, plus one to notice going over."""
@@ -69,6 +80,8 @@ class Budget:
 
     def add(self, count):
         self.total += count
+        if self.text and self.total > self.limit:
+            raise too_much_text(None)
         if self.total > self.limit:
             raise FormatError(
                 f"{self.what} unpacks to more than {human(self.limit)}; refusing "
@@ -81,10 +94,14 @@ class Budget:
             )
 
 
-def read_capped(stream, what):
-    """All of ``stream``, read in chunks, refused past MAX_INPUT_BYTES. A zip archive
-    comes back as a read-only memoryview, hashed as it arrived (rough.io.x3p.receive)."""
+def read_capped(stream, what, is_text=None):
+    """All of ``stream``, read in chunks, refused past MAX_INPUT_BYTES, and past
+    MAX_TEXT_BYTES once its first bytes show text (``is_text(head)``, asked with up
+    to :data:`rough.io.registry.HEAD` bytes): the cap applies while the bytes arrive,
+    so a stream is never read further than it. A zip archive comes back as a read-only
+    memoryview, hashed as it arrived (rough.io.x3p.receive)."""
     limit = cap("MAX_INPUT_BYTES")
+    from .registry import HEAD
     from .x3p import receive
 
     received = receive(stream, what, limit)
@@ -94,14 +111,38 @@ def read_capped(stream, what):
     if size is not None:
         if size > limit:
             raise _too_large(what, limit)
+        start = stream.tell()
+        if is_text is not None and size - start > cap("MAX_TEXT_BYTES") and is_text(stream.read(HEAD)):
+            raise too_much_text(size - start)
+        stream.seek(start)
         return stream.read()
-    parts, total = [], 0
-    while part := stream.read(min(CHUNK << 4, limit + 1 - total)):
+    parts, total, ceiling, text = [], 0, limit, None if is_text else False
+    while part := stream.read(min(HEAD if text is None else CHUNK << 4, ceiling + 1 - total)):
         parts.append(part)
         total += len(part)
+        if text is None and total >= HEAD:
+            text = is_text(b"".join(parts)[:HEAD])
+            ceiling = min(limit, cap("MAX_TEXT_BYTES")) if text else limit
         if total > limit:
             raise _too_large(what, limit)
-    return b"".join(parts)
+        if total > ceiling:
+            raise too_much_text(None)
+    data = b"".join(parts)
+    if text is None and total > cap("MAX_TEXT_BYTES") and is_text(data):
+        raise too_much_text(total)
+    return data
+
+
+def too_much_text(size):
+    """The refusal of text past MAX_TEXT_BYTES (``size`` bytes, None for a stream
+    refused as it arrived)."""
+    text_cap = human(cap("MAX_TEXT_BYTES"))
+    amount = (
+        f"{human(size)} of text is more than rough parses ({text_cap})"
+        if size is not None
+        else (f"more than {text_cap} of text, more than rough parses")
+    )
+    return FormatError(f"{amount}; convert it to X3P or NPY, or set ROUGH_MAX_TEXT_BYTES to raise the cap")
 
 
 def file_size(stream):

@@ -5,7 +5,8 @@ and 3; 834 bytes for formats 1 and 2, 4096 for format 3, as ``header_size`` at b
 says) is followed by the intensity buckets (``ac_n_buckets`` × ``ac_width`` ×
 ``ac_height`` big-endian uint16) and then the connected phase data, ``cn_width`` ×
 ``cn_height`` big-endian int32, row by row as the camera delivered them (row 0 is the
-first stored row; rough keeps that order). Phase values of 2147483640 and above mark
+first stored row; rough keeps that order), which end the file (a file of another
+length is refused). Phase values of 2147483640 and above mark
 invalid points (NaN here). Heights are phase × ``intf_scale_factor`` ×
 ``obliquity_factor`` × ``wavelength_in`` / R, where R is 4096, 32768 or 131072 for
 ``phase_res`` 0, 1 or 2, negated when ``sign`` is set; the pixel size is
@@ -44,8 +45,14 @@ def read(data, options):
         raise FormatError("MetroPro file holds no phase data (connected-phase size 0)")
     check_size((ny, nx), "the MetroPro phase map")
     offset = header["header_size"] + 2 * header["ac_n_buckets"] * header["ac_width"] * header["ac_height"]
-    if offset + 4 * nx * ny > len(data):
+    end = offset + 4 * nx * ny
+    if end > len(data):
         raise FormatError(f"MetroPro phase data of {nx}×{ny} points runs past the end of the file")
+    if end < len(data):
+        raise FormatError(
+            f"MetroPro file holds {len(data):,} bytes, its header describes {end:,} "
+            f"(intensity, then {nx}×{ny} phase points)"
+        )
     phase = np.frombuffer(data, ">i4", nx * ny, offset).reshape(ny, nx)
     heights = np.where(phase >= INVALID_PHASE, np.nan, phase * _height_scale(header))
     return Surface(heights, _spacing(header), units=Units(xy="m", z="m"), metadata=_metadata(header))

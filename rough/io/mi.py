@@ -5,7 +5,8 @@ A text header of lines with a 14-character key field and a value (``xPixels     
 ``yPixels``, ``xLength``, ``yLength`` (metres) and ``dateAcquired`` describe the scan. Each channel
 starts with a ``bufferLabel`` line, followed by its ``bufferRange`` and ``bufferUnit`` (``um``, ``V``),
 ``direction`` and ``filter``. The line ``data          BINARY`` (int16) or ``BINARY_32`` (int32) ends the
-header; the channels follow one after another, little-endian, a raw value over 2^15 (2^31) times
+header; the channels follow one after another to the end of the file (a file of another length is
+refused), little-endian, a raw value over 2^15 (2^31) times
 ``bufferRange`` giving the height in ``bufferUnit``. Note the mixed units: lateral metres, heights µm.
 Channels whose unit is not a length (Deflection, Friction in V) are listed but not read. ASCII data and
 spectroscopy files are not read. Facts from Gwyddion's ``mifile.c`` and SurfaceTopography's ``MI.py``.
@@ -46,6 +47,11 @@ def read(data, options):
         raise FormatError(
             f"MI file holds {len(data) - start} data bytes, fewer than {len(channels)} channels of "
             f"{nx}×{ny} points need ({block * len(channels)} bytes)"
+        )
+    if start + block * len(channels) < len(data):
+        raise FormatError(
+            f"MI file holds {len(data):,} bytes, its header describes {start + block * len(channels):,} "
+            f"(header and {len(channels)} channels of {nx}×{ny} points)"
         )
     names = [channel["bufferLabel"] for channel in channels]
     units = [metres_or_none(channel.get("bufferUnit", "")) for channel in channels]

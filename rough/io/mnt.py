@@ -28,7 +28,11 @@ vendor documentation exists. The facts used:
 
 SurfaceTopography 1.27.1 reads the same heights; its later reader applies a different
 height scale and takes every zero count as invalid, which drops 126 measured points of
-``mnt-2.mnt``. Spacing is the axis step (MountainsMap's own size is (n - 1) steps).
+``mnt-2.mnt``. MountainsMap's extent along an axis is (n - 1) steps, and its export of
+the same measurement (``bcrf-1.bcrf``) and SurfaceTopography give that extent as the
+size; in rough's convention (size = n · spacing) the spacing is therefore
+step · (n - 1) / n, and the size equals MountainsMap's extent (mnt-1: 1777.404 µm,
+not 960 steps = 1779.257 µm).
 """
 
 import io
@@ -82,7 +86,7 @@ def read(data, options):
     heights = counts * (z["step"] * z["factor"]) + z["offset"] * z["display_factor"]
     if VALIDITY in arrays:
         heights[_not_measured(contents, arrays[VALIDITY], nx, ny)] = np.nan
-    spacing = (x["step"] * x["factor"], y["step"] * y["factor"])
+    spacing = tuple(axis["step"] * axis["factor"] * max(axis["count"] - 1, 1) / axis["count"] for axis in (x, y))
     origin = (x["offset"] * x["display_factor"], y["offset"] * y["display_factor"])
     units = Units(xy=x["unit"], z=z["display_unit"])
     return Surface(heights, spacing, origin, units, _metadata(header))

@@ -3,17 +3,22 @@
 An INI-style text header (``[Section]`` and ``key=value`` lines, CRLF) starts with ``[DataSet]`` and ends
 where a line starts with ``#!``; the binary data follow those two bytes. ``[DataSet]`` lists the groups
 (``Gr0-Name=Scan forward``, ``Gr0-Count=8``) and the data sets of each (``Gr0-Ch1=DataSet-0:1``; missing
-numbers have no data). The data blocks follow in that order, group by group. Each data set's section gives
+numbers have no data). The data blocks follow in that order, group by group, and end the file (a file of
+another length is refused). Each data set's section gives
 ``Points`` (x), ``Lines`` (y), ``SaveBits``/``SaveSign``/``SaveOrder`` (``Intel`` is little-endian),
 ``Dim0Range``/``Dim1Range`` (the scan size in ``Dim0Unit``) and ``Dim2Name``, ``Dim2Unit``, ``Dim2Range``
 and ``Dim2Min``: a signed raw value v gives ``Dim2Min + Dim2Range * (v / 2^bits + 1/2)`` (Gwyddion's
 ``ezdfile.c``; SurfaceTopography's ``EZD.py`` leaves out the offset). Only data sets whose ``Dim2Unit`` is a
-length are channels here, named ``Frame (Dim2Name)`` as in SurfaceTopography; the first is the default.
+length are channels here, named ``Frame (Dim2Name)`` as in SurfaceTopography. The default is the first whose
+``Dim2Name`` names a height (``Z-Axis``, ``Z-AxisSensor``, ``Topography``, ``Height``): the channel is chosen
+by physical quantity, not by unit, since a deflection calibrated in metres is not a height. A file with no
+height channel is refused unless ``--channel`` names one of its length channels.
 
 Orientation: row 0 is the last line stored, as Gwyddion and SurfaceTopography show it.
 """
 
 import datetime
+import re
 
 import numpy as np
 
@@ -21,7 +26,7 @@ from ..errors import FormatError
 from ..surface import Surface, Units, check_size
 from ..units import metres_per
 from .header import header_count, header_number, ini_sections, length_unit, metres_or_none
-from .registry import Format, channel_metadata, choose_channel
+from .registry import Format, channel_list, channel_metadata, choose_channel
 
 FORMAT = Format(
     "nid",
@@ -33,6 +38,7 @@ FORMAT = Format(
 
 DATA_MAGIC = b"\n#!"
 MAX_GROUPS = 1000
+HEIGHT = re.compile(r"z[- ]?axis|z[- ]?sensor|topograph|height|^z$", re.IGNORECASE)
 
 
 def read(data, options):
@@ -45,7 +51,7 @@ def read(data, options):
     if not channels:
         raise FormatError("NID file holds no data set in a length unit (no height channel)")
     names = [channel["name"] for channel in channels]
-    index = choose_channel(names, options.channel, 0)
+    index = _default(channels, names) if options.channel is None else choose_channel(names, options.channel)
     channel = channels[index]
     nx, ny, fields = channel["nx"], channel["ny"], channel["fields"]
     raw = np.ndarray((ny, nx), channel["dtype"], data, channel["offset"])[::-1].astype(np.float64)
@@ -58,6 +64,17 @@ def read(data, options):
     spacing = (_number(fields, "Dim0Range") * lateral / nx, _number(fields, "Dim1Range") * lateral / ny)
     metadata = {"vendor": "Nanosurf", **_metadata(sections), **channel_metadata(names, index)}
     return Surface(heights, spacing, units=Units(xy=xy_unit, z=z_unit), metadata=metadata)
+
+
+def _default(channels, names):
+    """The first channel whose quantity (``Dim2Name``) is a height; FormatError when there is none."""
+    for index, channel in enumerate(channels):
+        if HEIGHT.search(channel["fields"].get("Dim2Name", "")):
+            return index
+    raise FormatError(
+        f"NID file holds no height channel (Z-Axis, Topography): its length channels {channel_list(names)} "
+        "are other quantities; give --channel to read one of them anyway"
+    )
 
 
 def _sections(text):
@@ -87,6 +104,8 @@ def _channels(sections, start, file_size):
                 name = f"{fields.get('Frame', section)} ({fields.get('Dim2Name', '')})"
                 channels.append({"name": name, "nx": nx, "ny": ny, "dtype": dtype, "offset": offset, "fields": fields})
             offset = end
+    if channels and offset != file_size:
+        raise FormatError(f"NID file holds {file_size:,} bytes, its header describes {offset:,} (header and data sets)")
     return channels
 
 

@@ -1,7 +1,8 @@
 """Nanofocus µsurf NMS (confocal microscopes), read only.
 
 A fixed 3468-byte little-endian header, then nx × ny uint16 heights, row by row (row 0
-first, as stored), then nx × ny uint8 intensities (not read). Header fields used: the
+first, as stored), then nx × ny uint8 intensities (not read), and nothing after them: a file of
+another length is refused. Header fields used: the
 z range zmin, zmax (float64, µm) at byte 16, the format name (``OM_MS_2.0``) at byte
 32, the image kind (``Confocal Height Image``) at byte 52, the date (``YYYY-MM-DDTHH:MM``)
 at byte 1076, nx, ny (uint32) at byte 1368 and dx, dy (float64, **nm**) at byte 1376.
@@ -51,6 +52,11 @@ def read(data, options):
     check_size((ny, nx), "the NMS height image")
     if HEADER_SIZE + 2 * nx * ny > len(data):
         raise FormatError(f"NMS height image of {nx}×{ny} points runs past the end of the file")
+    if HEADER_SIZE + 3 * nx * ny != len(data):
+        raise FormatError(
+            f"NMS file holds {len(data):,} bytes, its header describes {HEADER_SIZE + 3 * nx * ny:,} "
+            f"(header, {nx}×{ny} uint16 heights and uint8 intensities)"
+        )
     if not (np.isfinite(zmin) and np.isfinite(zmax) and zmax >= zmin):
         raise FormatError(f"NMS z range {zmin!r} … {zmax!r} µm is not a range")
     for name, step in (("dx", dx), ("dy", dy)):

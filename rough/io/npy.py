@@ -16,8 +16,9 @@ FORMAT = Format("npy", "NumPy NPY", (".npy",), magic=(b"\x93NUMPY",), writes=Tru
 
 
 def read(data, options):
-    """The header is checked (numbers, 1-D or 2-D, as many bytes as it declares) before
-    any array is made; object arrays are never unpickled."""
+    """The header is checked (numbers, 1-D or 2-D, exactly as many bytes as it
+    declares: more or fewer mean a damaged file) before any array is made; object
+    arrays are never unpickled."""
     stream = io.BytesIO(bytes(data))
     try:
         version = np.lib.format.read_magic(stream)
@@ -35,7 +36,7 @@ def read(data, options):
         raise FormatError(f"NPY shape {shape} is not a list of sizes")
     count = int(np.prod(shape, dtype=object))
     available = len(data) - stream.tell()
-    if count * dtype.itemsize > available:
+    if count * dtype.itemsize != available:
         raise FormatError(
             f"NPY header declares {'×'.join(map(str, shape))} values of {dtype.itemsize} bytes; the file "
             f"holds {available} bytes"

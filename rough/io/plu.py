@@ -10,7 +10,11 @@ layers follow at 500: uint32 rows and columns, rows × columns float32 heights i
 (x fastest, first stored row kept as row 0 here), float32 min and max. The value
 1000001 marks non-measured points (NaN here). There is no magic number: the format is
 chosen by its extension (.plu, .apx). Several layers are offered as channels
-``layer 0``, ``layer 1``, ...; the colour image after the layers is not read.
+``layer 0``, ``layer 1``, ...; the colour image after the layers (rows × columns RGB bytes) is not read.
+After the last layer's min and max the file ends, or holds at least that colour image (plu-1.plu
+holds 133,133 bytes more, of unknown layout); a file that ends inside a layer's min and max, or
+holds fewer bytes than the colour image after it, is refused. The min and max cannot check the
+heights: plu-1.plu states -1000001 and 1000001.
 """
 
 import datetime
@@ -73,10 +77,17 @@ def _layers(data, count):
             raise FormatError(f"PLU layer of {columns} × {rows} points is empty")
         check_size((rows, columns), "the PLU layer")
         position += 8
-        if position + rows * columns * 4 > len(data):
-            raise FormatError(f"PLU heights of {columns} × {rows} points run past the end of the file")
+        if position + rows * columns * 4 + 8 > len(data):
+            raise FormatError(
+                f"PLU heights of {columns} × {rows} points and their min and max run past the end of the file"
+            )
         layers.append(np.frombuffer(data, "<f4", rows * columns, position).reshape(rows, columns))
         position += rows * columns * 4 + 8
+    if 0 < len(data) - position < 3 * rows * columns:
+        raise FormatError(
+            f"PLU file holds {len(data) - position:,} bytes after its layers, where only nothing or their "
+            f"{columns} × {rows} colour image ({3 * rows * columns:,} bytes) and more may follow"
+        )
     return layers
 
 

@@ -6,9 +6,9 @@ binary header (at least 356 bytes in version 1, 580 in version 2, little-endian,
 The header gives the image type (0: a 2-D map), the channel's name (``Z Height``), x and y points, the
 scan size in µm, ``swap_xy``, and the height scaling: a raw value v gives
 ``(v * z_scale + z_offset) * data_gain`` in the header's z unit. Version 2 adds the data type (int16,
-int32 or float32; version 1 is always int16). Header layout as Gwyddion's ``psia.c`` and SurfaceTopography's
-``PS.py`` read it (the latter leaves out ``z_offset``). Line profiles, spectroscopy and images with swapped
-axes are not read.
+int32 or float32; version 1 is always int16); the data tag holds exactly the points, no more, no fewer.
+Header layout as Gwyddion's ``psia.c`` and SurfaceTopography's ``PS.py`` read it (the latter leaves out
+``z_offset``). Line profiles, spectroscopy and images with swapped axes are not read.
 
 Orientation: row 0 is the last line stored, as Gwyddion shows it (SurfaceTopography keeps the stored order).
 """
@@ -21,7 +21,7 @@ import numpy as np
 
 from ..errors import FormatError
 from ..surface import Surface, Units, check_size
-from .header import length_unit, quiet
+from .header import first_tiff_tags, length_unit, quiet
 from .registry import Format, channel_metadata
 
 MAGIC = 0x0E031301
@@ -32,15 +32,7 @@ DATA_TYPES = {0: "<i2", 1: "<i4", 2: "<f4"}
 
 def probe(head):
     """Tag 50432 with Park's magic number among the first IFD's entries."""
-    order = {b"II": "<", b"MM": ">"}.get(bytes(head[:2]))
-    if order is None or len(head) < 8:
-        return False
-    (ifd,) = struct.unpack_from(order + "I", head, 4)
-    if ifd + 2 > len(head):
-        return False
-    (count,) = struct.unpack_from(order + "H", head, ifd)
-    for entry in range(min(count, (len(head) - ifd - 2) // 12)):
-        tag, kind, number, value = struct.unpack_from(order + "HHII", head, ifd + 2 + 12 * entry)
+    for tag, kind, number, value in first_tiff_tags(head):
         if tag == TAG_MAGIC:
             return kind == 4 and number == 1 and value == MAGIC
     return False
@@ -74,6 +66,11 @@ def read(data, options):
     payload = _bytes(tags, TAG_DATA)
     if len(payload) < nx * ny * dtype.itemsize:
         raise FormatError(f"Park Systems data tag holds {len(payload)} bytes, fewer than {nx}×{ny} points need")
+    if len(payload) > nx * ny * dtype.itemsize:
+        raise FormatError(
+            f"Park Systems data tag holds {len(payload):,} bytes, more than its {nx}×{ny} points "
+            f"({nx * ny * dtype.itemsize:,} bytes)"
+        )
     raw = np.frombuffer(payload, dtype, nx * ny).reshape(ny, nx)[::-1].astype(np.float64)
     z_unit = header["z_unit"] or "um"
     metres = length_unit(z_unit, "Park Systems z unit")

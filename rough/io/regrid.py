@@ -4,6 +4,13 @@ regridded on request (``--regrid SPACING``) and refused without it.
 x counts as evenly spaced when every point lies within ``TOLERANCE`` of a step of the
 line through the first and the last; the spacing is that line's slope (the mean step)
 and the origin the first x. Regridding is recorded in the surface's history.
+
+The default method is linear: every new height lies between its two neighbours read,
+so it cannot ring or overshoot, and on a nearly even profile (one x of 960 off by a
+fifth of a step) it changes Rq by less than 0.1 %. ``bandlimited`` is for coarsening: it also
+removes what the new grid cannot hold (an ideal low-pass, which rings at steps in the
+heights), and is the same as linear when the new spacing is no coarser than the
+median step of x.
 """
 
 import math
@@ -60,13 +67,13 @@ def profile_from_points(x, z, options, *, units=Units(), metadata=None, history=
 
 def option(value):
     """``(spacing, method)`` from a ``--regrid`` value: a spacing in metres, or a
-    ``(spacing, method)`` pair (method default ``"bandlimited"``). Raises InputError
+    ``(spacing, method)`` pair (method default ``"linear"``). Raises InputError
     for a spacing that is not a positive length or an unknown method.
 
-    >>> option(5e-7), option((5e-7, "linear"))
-    ((5e-07, 'bandlimited'), (5e-07, 'linear'))
+    >>> option(5e-7), option((5e-7, "bandlimited"))
+    ((5e-07, 'linear'), (5e-07, 'bandlimited'))
     """
-    spacing, method = value if isinstance(value, (tuple, list)) else (value, "bandlimited")
+    spacing, method = value if isinstance(value, (tuple, list)) else (value, "linear")
     try:
         spacing = float(spacing)
     except (TypeError, ValueError):
@@ -78,16 +85,19 @@ def option(value):
     return spacing, method
 
 
-def regrid(x, z, spacing, method="bandlimited"):
+def regrid(x, z, spacing, method="linear"):
     """Heights at ``x[0] + spacing * k`` (k = 0 … up to ``x[-1]``) from points ``(x, z)``
     with increasing x.
 
-    ``linear`` interpolates between neighbours. ``bandlimited`` first interpolates
-    linearly onto a grid at least twice as fine as both ``spacing`` and the median step
-    of x, then removes what lies above the new grid's Nyquist frequency (an ideal
-    low-pass filter by FFT, after the line through the ends is taken out and before it
-    is put back, so that the ends do not ring), so a coarser grid does not alias. Invalid (NaN) heights
-    are skipped, and an interval of the new grid with no valid point near it is NaN.
+    ``linear`` interpolates between neighbours: it cannot ring. ``bandlimited``, for
+    coarsening, interpolates linearly onto the grid of ``spacing / m`` nearest to the
+    median step of x from below (m whole; the data's own grid when ``spacing`` is a
+    multiple of it, so no height is smoothed by the interpolation), then removes what
+    lies above the new grid's Nyquist frequency (an ideal low-pass filter by FFT, after
+    the line through the ends is taken out and before it is put back, so that the ends
+    do not ring) and keeps every m-th point; with m = 1 (a spacing no coarser than the
+    median step) there is nothing to remove and it is linear. Invalid (NaN) heights are
+    skipped, and an interval of the new grid with no valid point near it is NaN.
     """
     spacing, method = option((spacing, method))
     count = int(np.floor((x[-1] - x[0]) / spacing * (1 + 1e-12))) + 1
@@ -98,10 +108,10 @@ def regrid(x, z, spacing, method="bandlimited"):
     check_size((count,), "the regridded profile")
     valid = np.isfinite(z)
     target = x[0] + spacing * np.arange(count)
-    if method == "linear":
+    factor = int(np.ceil(spacing / np.median(np.diff(x)) * (1 - 1e-9)))
+    if method == "linear" or factor <= 1:
         heights = np.interp(target, x[valid], z[valid])
     else:
-        factor = max(2, int(np.ceil(2 * spacing / np.median(np.diff(x)))))
         check_size((count * factor,), "the band-limited regrid's working grid")
         fine = np.interp(x[0] + spacing / factor * np.arange((count - 1) * factor + 1), x[valid], z[valid])
         line = np.linspace(fine[0], fine[-1], len(fine))  # removed so that the ends meet: no ringing at the wrap

@@ -1,11 +1,18 @@
-"""ISO 25178-71 SDF (Surface Data File), read only: the ASCII (``aISO-1.0``) and
-binary (``bISO-1.0``) variants, uncompressed.
+"""ISO 25178-71 SDF (Surface Data File), read only: the ASCII (``aISO-1.0``,
+``aISO-2.0``) and binary (``bISO-1.0``, ``bISO-2.0``) variants, uncompressed.
 
 The header gives NumPoints (x) × NumProfiles (y), Xscale and Yscale (metres per
 point) and Zscale (metres per data unit). ASCII data are whitespace-separated
-numbers in which ``BAD`` marks an invalid point (NaN); binary data use DataType
+numbers in which ``BAD`` marks an invalid point (NaN), closed by a ``*`` line (a file
+without it is cut short and refused, since its last number may be cut); binary data use DataType
 0–7 (uint8, uint16, uint32, float32, int8, int16, int32, float64), little-endian.
+The 2.0 revision keeps the ASCII layout and widens the binary NumPoints and
+NumProfiles from uint16 to uint32 (as surfalize's ``sdf.py`` reads it).
 One profile (NumProfiles = 1) reads as a profile.
+
+Binary data end the file, or are followed by a text trailer closed by a ``*`` line (as the
+ASCII variant's trailer is); other bytes after them are refused, since nothing else tells a
+trailer from data moved by damage.
 """
 
 import re
@@ -22,18 +29,23 @@ FORMAT = Format(
     "sdf",
     "ISO 25178-71 SDF",
     (".sdf",),
-    magic=(b"aISO-1.0", b"bISO-1.0"),
+    magic=(b"aISO-1.0", b"bISO-1.0", b"aISO-2.0", b"bISO-2.0"),
     carries=("spacing", "metadata", "time", "mask"),
 )
 
-BINARY_HEADER = struct.Struct("<8s10s12s12sHHddddBBB")
+BINARY_HEADERS = {
+    b"bISO-1.0": struct.Struct("<8s10s12s12sHHddddBBB"),
+    b"bISO-2.0": struct.Struct("<8s10s12s12sIIddddBBB"),
+}
+ASCII_MAGIC = ("aISO-1.0", "aISO-2.0")
 DATA_TYPES = ("<u1", "<u2", "<u4", "<f4", "<i1", "<i2", "<i4", "<f8")
 MAX_POINTS = 1 << 31
+TRAILER = re.compile(rb"[\t\n\r\x20-\x7e]*\*\s*")
 
 
 def read(data, options):
-    if bytes(data[:8]) == b"bISO-1.0":
-        header, values = _binary(data)
+    if bytes(data[:8]) in BINARY_HEADERS:
+        header, values = _binary(data, BINARY_HEADERS[bytes(data[:8])])
     else:
         header, values = _ascii(bytes(data).decode("latin-1"))
     nx, ny = header["NumPoints"], header["NumProfiles"]
@@ -49,8 +61,8 @@ def read(data, options):
 
 def _ascii(text):
     lines = text.splitlines()
-    if not lines or lines[0].strip() != "aISO-1.0":
-        raise FormatError("not an SDF file (no aISO-1.0 line)")
+    if not lines or lines[0].strip() not in ASCII_MAGIC:
+        raise FormatError("not an SDF file (no aISO-1.0 or aISO-2.0 line)")
     header, position = {}, 1
     while position < len(lines) and lines[position].strip() != "*":
         key, equals, value = lines[position].partition("=")
@@ -65,6 +77,8 @@ def _ascii(text):
         if line.strip() == "*":
             break
         body.extend(line.split())
+    else:
+        raise FormatError("SDF data are not closed by a '*' line (the file is cut short)")
     count = header["NumPoints"] * header["NumProfiles"]
     if len(body) != count:
         raise FormatError(
@@ -77,10 +91,10 @@ def _ascii(text):
     return header, values
 
 
-def _binary(data):
-    if len(data) < BINARY_HEADER.size:
-        raise FormatError("binary SDF file shorter than its 81-byte header")
-    fields = BINARY_HEADER.unpack_from(bytes(data[: BINARY_HEADER.size]))
+def _binary(data, layout):
+    if len(data) < layout.size:
+        raise FormatError(f"binary SDF file shorter than its {layout.size}-byte header")
+    fields = layout.unpack_from(bytes(data[: layout.size]))
     names = (
         "version",
         "ManufacID",
@@ -103,9 +117,15 @@ def _binary(data):
     header = _checked(header)
     dtype = np.dtype(DATA_TYPES[header["DataType"]])
     count = header["NumPoints"] * header["NumProfiles"]
-    if BINARY_HEADER.size + count * dtype.itemsize > len(data):
+    if layout.size + count * dtype.itemsize > len(data):
         raise FormatError(f"binary SDF declares {count} points but is too short to hold them")
-    return header, np.frombuffer(data, dtype, count=count, offset=BINARY_HEADER.size)
+    end = layout.size + count * dtype.itemsize
+    if end < len(data) and not TRAILER.fullmatch(bytes(data[end:])):
+        raise FormatError(
+            f"binary SDF file holds {len(data):,} bytes, its header describes {end:,} ({count} points of "
+            f"{dtype.itemsize} bytes), and the rest is not a text trailer closed by '*'"
+        )
+    return header, np.frombuffer(data, dtype, count=count, offset=layout.size)
 
 
 def _checked(header):

@@ -19,9 +19,23 @@ concatenate to the same points; points that would unpack to more than ``MAX_RATI
 
 Facts from Gwyddion's ``surffile.c`` (header layout, compressed streams, unit fix for
 the old code-page micro sign) and surfalize's ``sur.py`` (the ``zmin - 2`` marker).
+The objects fill the file to its last byte, and their measured counts lie within each
+header's zmin … zmax (bytes 100 and 104; on both example files they are the counts'
+extremes); a file that breaks either is refused.
 Several objects (series, multilayer, RGB-intensity surfaces) are offered as channels
-named by their z axis; the height object is the default. The inversion flag is recorded,
-not applied.
+named by their z axis; the first height object is the default. An object is heights when
+its studiable type is a profile or surface kind (1, 2, 4, 5, 7, 8, 11, 13, 16) and its
+z unit is a length (an empty z unit is ``--unit``, else not a length); images (binary,
+intensity, RGB: types 3, 10, 12), force curves and spectra are refused, as is an object
+chosen with ``--channel`` that is not heights. An empty lateral unit is ``--unit``, else
+metres. The inversion flag is recorded, not applied.
+
+Non-measured points: Gwyddion 2.62 ignores the flag and keeps the marker values as
+heights; on ``sur-3.sur`` (flag set, zmin 0) 233,009 of 262,144 points hold ``-2``, two
+counts below every measured point, so Gwyddion's Sq (1.920 mm) and the 1.92 mm of
+SurfaceTopography's test mostly measure the step between the marker and the measured
+points. Gwyddion's heights equal rough's on every measured point; rough's Sq is
+1.1132 mm, as SurfaceTopography 1.27.1 reads it.
 """
 
 import datetime
@@ -33,7 +47,7 @@ import numpy as np
 from ..errors import FormatError
 from ..surface import Surface, Units, check_size
 from . import limits, registry
-from .header import length_unit
+from .header import length_unit, metres_or_none
 from .registry import Format
 
 FORMAT = Format(
@@ -50,6 +64,8 @@ MAX_OBJECTS = 4096
 MAX_STREAMS = 1 << 16
 TYPES = {1: "profile", 2: "surface", 5: "series of surfaces", 7: "multilayer profile", 8: "multilayer surface"}
 TYPES |= {10: "intensity image", 11: "intensity surface", 12: "RGB image", 16: "RGB intensity surface"}
+TYPES |= {3: "binary image", 4: "series of profiles", 13: "RGB surface", 14: "force curve", 20: "spectrum"}
+HEIGHT_TYPES = {1, 2, 4, 5, 7, 8, 11, 13, 16}
 ACQUISITION = {1: "contact stylus", 2: "scanning optical gauge", 5: "contact stylus with skid", 6: "AFM"}
 ACQUISITION |= {7: "STM", 8: "video", 9: "interferometer", 10: "structured light projection"}
 
@@ -58,15 +74,23 @@ def read(data, options):
     data = bytes(data)
     objects = _objects(data)
     names = [_channel_name(header, index) for index, (header, _) in enumerate(objects)]
-    index = registry.choose_channel(names, options.channel)
+    heights_objects = [index for index, (header, _) in enumerate(objects) if _is_height(header, options)]
+    if options.channel is not None:
+        index = registry.choose_channel(names, options.channel)
+    elif heights_objects:
+        index = heights_objects[0]
+    else:
+        index = 0
     header, offset = objects[index]
-    heights = _heights(data, header, offset)
+    if index not in heights_objects:
+        raise FormatError(_not_heights(names[index], header))
+    heights = _heights(data, header, offset, options)
     metadata = _metadata(objects[0][0])
     if len(objects) > 1:
         metadata |= registry.channel_metadata(names, index)
-    units = Units(xy=header["dx_unit"] or "m", z=header["dz_unit"] or "m")
-    spacing = (_step(header, "dx"), _step(header, "dy"))
-    origin = (header["x_offset"] * _factor(header["dx_unit"]), header["y_offset"] * _factor(header["dy_unit"]))
+    units = Units(xy=header["dx_unit"] or options.unit or "m", z=header["dz_unit"] or options.unit)
+    spacing = (_step(header, "dx", options), _step(header, "dy", options))
+    origin = tuple(header[f"{axis}_offset"] * _factor(header[f"d{axis}_unit"], options) for axis in "xy")
     if heights.shape[0] == 1:
         return Surface(heights[0], spacing[:1], origin[:1], units, metadata)
     return Surface(heights, spacing, origin, units, metadata)
@@ -88,6 +112,8 @@ def _objects(data):
             )
     if not objects:
         raise FormatError("not a SUR file (no DIGITAL SURF or DSCOMPRESSED header of 512 bytes)")
+    if position != len(data):
+        raise FormatError(f"SUR file holds {len(data):,} bytes, its {len(objects)} objects {position:,}")
     return objects
 
 
@@ -110,6 +136,7 @@ def _header(data, position):
         "non_measured": field(86, "h"),
         "bits": field(98, "h"),
         "zmin": field(100, "i"),
+        "zmax": field(104, "i"),
         "nx": field(108, "i"),
         "ny": field(112, "i"),
         "dx": field(120, "f"),
@@ -140,15 +167,40 @@ def _data_size(header):
     return header["compressed_size"] if header["compressed"] else header["nx"] * header["ny"] * header["bits"] // 8
 
 
-def _heights(data, header, offset):
+def _not_heights(name, header):
+    if header["type"] not in HEIGHT_TYPES:
+        kind = TYPES.get(header["type"], f"type {header['type']}")
+        return f"SUR object {name!r} is a {kind}, not heights; rough reads height maps and profiles"
+    if not header["dz_unit"]:
+        return f"SUR object {name!r} names no z unit, so its values are not known to be heights; give --unit"
+    return f"SUR object {name!r} holds values in {header['dz_unit']!r}, not a length unit: not heights"
+
+
+def _is_height(header, options):
+    return header["type"] in HEIGHT_TYPES and metres_or_none(header["dz_unit"] or options.unit or "") is not None
+
+
+def _heights(data, header, offset, options):
     dtype = np.dtype("<i2" if header["bits"] == 16 else "<i4")
     raw = _inflate(data, header, offset) if header["compressed"] else data[offset : offset + _data_size(header)]
     counts = np.frombuffer(raw, dtype, header["nx"] * header["ny"]).reshape(header["ny"], header["nx"])
-    z_factor = _factor(header["dz_unit"])
+    _check_range(counts, header)
+    z_factor = _factor(header["dz_unit"], options)
     heights = counts * (float(header["dz"]) * z_factor) + header["z_offset"] * z_factor
     if header["non_measured"] == 1:
         heights[counts == header["zmin"] - 2] = np.nan
     return heights
+
+
+def _check_range(counts, header):
+    """FormatError when a measured count lies outside the header's zmin … zmax (when it states a range)."""
+    low, high = header["zmin"], header["zmax"]
+    measured = counts[counts != low - 2] if header["non_measured"] == 1 else counts
+    if high > low and measured.size and (measured.min() < low or measured.max() > high):
+        raise FormatError(
+            f"SUR points span {measured.min()} … {measured.max()} counts, outside the header's "
+            f"zmin … zmax, {low} … {high}: the data block is not the one the header describes"
+        )
 
 
 def _inflate(data, header, offset):
@@ -177,14 +229,12 @@ def _inflate(data, header, offset):
     return b"".join(parts)
 
 
-def _factor(unit):
-    if not unit:
-        return 1.0
-    return length_unit(unit, "SUR unit")
+def _factor(unit, options):
+    return length_unit(unit or options.unit or "m", "SUR unit")
 
 
-def _step(header, key):
-    step = abs(header[key]) * _factor(header[f"{key}_unit"])
+def _step(header, key, options):
+    step = abs(header[key]) * _factor(header[f"{key}_unit"], options)
     if not 0 < step < np.inf:
         raise FormatError(f"SUR spacing {key} is {header[key]!r} {header[key + '_unit']}, not a positive length")
     return step

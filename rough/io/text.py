@@ -29,12 +29,19 @@ to count); the spacing is their least-squares slope. Profiles with unevenly
 spaced x go through :func:`rough.io.regrid.profile_from_points`: gridded on request
 (``--regrid``), refused otherwise. ``nan`` and ``BAD`` mark invalid points.
 
-Written (TSV): ``#`` lines with the unit, spacing, origin, units, metadata and one line
-per history entry, then ``x z`` (profiles) or ``x y z`` (maps, a blank line between
-rows, as gnuplot expects), in metres, with every float printed to round-trip exactly.
+Written (TSV): ``#`` lines with the unit, spacing, origin, point count, units, metadata
+and one line per history entry, then ``x z`` (profiles) or ``x y z`` (maps, a blank line
+after each row, as gnuplot expects), in metres, with every float printed to round-trip
+exactly, every line ended.
+
+A file cut short is refused where it shows (docs/formats.rst, "Damaged files"): rough's
+own TSV by its point count and line ends, other text by a last line without a line end
+that has fewer values than the line above or whose last number is printed unlike its
+column's.
 """
 
 import json
+import logging
 import re
 import unicodedata
 
@@ -46,6 +53,8 @@ from ..surface import Surface, Units
 from ..units import metres_per
 from . import provenance, regrid
 from .registry import Format
+
+log = logging.getLogger("rough")
 
 
 def _looks_like_text(head):
@@ -67,6 +76,8 @@ _NUMERIC = re.compile(r"^[\s,;]*[+-]?(\d|\.\d|nan|inf|bad)", re.IGNORECASE)
 _BAD = re.compile(r"\bBAD\b", re.IGNORECASE)
 _NUMBER = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$")
 _MISTYPED_NUMBER = re.compile(r"^[+-]?[\dOoIl]*[\d.][\dOoIl.]*([eE][+-]?\d+)?$")
+_PRINTED = re.compile(r"^[+-]?\d*(?:[.,](\d*))?(?:[eE][+-]?(\d*))?$")
+_BLANK_LINE_AT_END = re.compile(r"(\r\n|\n|\r)[ \t]*(\r\n|\n|\r)\s*$")
 _INFINITY = re.compile(r"^[+-]?inf(inity)?$", re.IGNORECASE)
 _COUNT = re.compile(r"^\s*\d+\s*$")
 _INDEX_NAMES = ("index", "idx", "#", "no", "no.", "nr", "n", "point")
@@ -82,14 +93,97 @@ class _BadLine(FormatError):
 
 
 def read(data, options):
-    raw = _decode(data).splitlines()
+    text = _decode(data)
+    raw = text.splitlines()
     lines = [line for line in raw if line.strip()]
     if not lines:
         raise FormatError("empty text file, no surface to read")
     try:
+        _check_ending(text, lines)
+        del text  # the lines hold the data from here on: a map's text is tens of MB
         return _read_lines(lines, options)
     except _BadLine as error:
         raise FormatError(f"line {_line_number(raw, error.line)}: {error}") from None
+
+
+def _check_ending(text, lines):
+    """Refuse a file cut short (docs/formats.rst, "Damaged files"). rough's own TSV
+    ends every line, and a map's every row with a blank line. A file of any other
+    kind whose last line has no line end is cut short when that line has fewer
+    values than the line before it, or when its last number is printed unlike the
+    numbers above it in its column (or, with none above, the numbers before it in
+    its line), two or more that share one style: without their exponent, with a
+    shorter exponent, or with fewer decimals. Otherwise a warning says that the last
+    value may be cut."""
+    if lines[0].startswith("# rough "):
+        if not text.endswith(("\n", "\r")):
+            raise _BadLine(lines[-1], "the last line has no line end; rough ends every line, so the file was cut short")
+        if " map:" in lines[0] and not _BLANK_LINE_AT_END.search(_trailing_space(text)):
+            raise _BadLine(lines[-1], "the last row of the map has no blank line after it, so the file was cut short")
+        return
+    if text.endswith(("\n", "\r")) or not _NUMERIC.match(lines[-1]):
+        return
+    numeric_above = len(lines) > 1 and _NUMERIC.match(lines[-2])
+    delimiter = _delimiter(lines[-2] if numeric_above else lines[-1])
+    last = [field for field in _split(lines[-1], delimiter) if field]
+    above = [field for field in _split(lines[-2], delimiter) if field] if numeric_above else []
+    if len(last) < len(above):
+        raise _BadLine(
+            lines[-1],
+            f"the last line has {len(last)} values where the line before has {len(above)}, "
+            "and no line end: the file was cut short",
+        )
+    column = [fields[len(last) - 1] for fields in _column_above(lines, delimiter, len(last))] or last[:-1]
+    if _printed_unlike(last[-1], column):
+        raise _BadLine(
+            lines[-1],
+            f"the last number, {last[-1]!r}, is printed unlike the others of its column (e.g. {column[-1]!r}) "
+            "and the file has no line end: it was cut short (if not, end the file with a line end)",
+        )
+    log.warning("the file has no line end after its last value, %r: if it was cut short, that value is wrong", last[-1])
+
+
+def _trailing_space(text):
+    """The white space that ends ``text``, found without a pass over the rest."""
+    end = len(text)
+    while end and text[end - 1].isspace():
+        end -= 1
+    return text[end:]
+
+
+def _column_above(lines, delimiter, count):
+    """The fields of up to 100 numeric lines before the last that have ``count`` values."""
+    rows = []
+    for line in reversed(lines[-101:-1]):
+        fields = [field for field in _split(line, delimiter) if field]
+        if not _NUMERIC.match(line) or len(fields) != count:
+            break
+        rows.append(fields)
+    return rows
+
+
+def _printed_unlike(token, column):
+    """Whether ``token`` reads as a cut copy of the style that the numbers of
+    ``column`` (two or more) share: all with an exponent (it has none, or fewer
+    exponent digits than any of them), or all without one and with the same count of
+    decimals (it has fewer)."""
+    styles = [_style(field) for field in column]
+    mine = _style(token)
+    if len(column) < 2 or mine is None or None in styles:
+        return False
+    exponents = {exponent for _, exponent in styles}
+    if 0 not in exponents:
+        return mine[1] < min(exponents)
+    decimals = {decimal for decimal, _ in styles}
+    return exponents == {0} and len(decimals) == 1 and mine[0] < min(decimals)
+
+
+def _style(token):
+    """``(decimals, exponent digits)`` of a printed number, None for other text."""
+    match = _PRINTED.match(token)
+    if not match:
+        return None
+    return len(match.group(1) or ""), len(match.group(2) or "")
 
 
 def _line_number(raw, line):
@@ -132,6 +226,7 @@ def header_lines(surface):
         "unit: m",
         "spacing: " + " ".join(repr(d) for d in surface.spacing),
         "origin: " + " ".join(repr(o) for o in surface.origin),
+        "points: " + " ".join(map(str, surface.points)),
         "units: " + json.dumps(parts["units"]),
         "metadata: " + json.dumps(parts["metadata"]),
         *("history: " + json.dumps(entry) for entry in parts["history"]),
@@ -151,6 +246,20 @@ def _write_rows(stream, x_text, y_text, heights):
 
 
 def _columns(lines, options):
+    """The surface in columns of numbers, checked against the point count of rough's
+    own header (``# points: NX NY``) where it has one (a map one point wide reads as
+    a profile)."""
+    settings, surface = _read_columns(lines, options)
+    stated = [count for count in _floats(settings.get("points", "")) if count != 1]
+    if "points" in settings and stated != [count for count in surface.points if count != 1]:
+        raise FormatError(
+            f"the header says {settings['points'].strip()} points, the data hold "
+            f"{' '.join(map(str, surface.points))}: the file was cut short or changed"
+        )
+    return surface
+
+
+def _read_columns(lines, options):
     comments = [line.lstrip("#%").strip() for line in lines if line.lstrip().startswith(("#", "%"))]
     settings = _comment_settings(comments)
     body = [line for line in lines if not line.lstrip().startswith(("#", "%"))]
@@ -173,16 +282,18 @@ def _columns(lines, options):
         keep = [i for i in range(count) if i != flag][:2]
         heights = np.where(table[:, flag] != 0, table[:, keep[1]], np.nan)
         x_tokens = _column_tokens(body, delimiter, first + keep[0])
-        return _profile(table[:, keep[0]], heights, (units[keep[0]], units[keep[1]]), settings, options, x_tokens)
+        return settings, _profile(
+            table[:, keep[0]], heights, (units[keep[0]], units[keep[1]]), settings, options, x_tokens
+        )
     if count == 1:
-        return _from_spacing(table[:, 0] * metres_per(units[0]), options, settings, Units(units[0], units[0]))
+        return settings, _from_spacing(table[:, 0] * metres_per(units[0]), options, settings, Units(units[0], units[0]))
     if count == 2:
         x_tokens = _column_tokens(body, delimiter, first)
-        return _profile(table[:, 0], table[:, 1], units[:2], settings, options, x_tokens)
+        return settings, _profile(table[:, 0], table[:, 1], units[:2], settings, options, x_tokens)
     if count == 3:
-        return _grid(table, units, settings)
+        return settings, _grid(table, units, settings)
     heights = table * metres_per(default_unit)
-    return _from_spacing(
+    return settings, _from_spacing(
         heights if len(heights) > 1 else heights[0], options, settings, Units(default_unit, default_unit)
     )
 
@@ -289,7 +400,7 @@ def _comment_settings(comments):
             continue
         if key == "history":
             history.append(json.loads(value))
-        elif key in ("unit", "spacing", "origin", "units", "metadata"):
+        elif key in ("unit", "spacing", "origin", "units", "metadata", "points"):
             settings[key] = value.strip()
     settings["history"] = history
     return settings
@@ -350,6 +461,12 @@ def _numbers(body, delimiter, columns):
     try:
         table = np.loadtxt(rows, delimiter=delimiter, usecols=tuple(columns), ndmin=2, comments=None)
     except ValueError as error:
+        short = re.match(r"invalid column index \d+ at row (\d+) with (\d+) columns", str(error))
+        if short and int(short.group(1)) <= len(body):  # loadtxt counts these rows from 1
+            line, count = body[int(short.group(1)) - 1], int(short.group(2))
+            raise _BadLine(
+                line, f"{count} value{'s' * (count != 1)} where the first row has {len(columns)} (a row cut short?)"
+            ) from None
         row = re.search(r",? at row (\d+)", str(error))
         if row and int(row.group(1)) < len(body):
             line = body[int(row.group(1))]

@@ -4,9 +4,10 @@ Layout (little-endian), as SurfaceTopography's and surfalize's readers read it: 
 32-byte magic ``Binary TrueMap Data File v2.0\\r\\n\\0``, a 24-byte comment (v2 only),
 then uint32 width and height (points), float32 x and y lengths and x and y offsets,
 then width × height float32 heights, row by row, x fastest (the first stored row is
-row 0 here). The format names no unit: lengths and heights are taken as micrometres,
-as both readers do. Spacing is length / points; NaN heights stay invalid. Version 1
-files (no comment field) are read by the same rule.
+row 0 here), which end the file (a file of another length is refused). The format
+names no unit: lengths and heights are taken as micrometres, as both readers do.
+Spacing is length / points; NaN heights stay invalid. Version 1 files (no comment
+field) are read by the same rule.
 """
 
 import struct
@@ -38,6 +39,11 @@ def read(data, options):
     start = position + 24
     if start + nx * ny * 4 > len(data):
         raise FormatError(f"TMD heights of {nx} × {ny} points run past the end of the file")
+    if start + nx * ny * 4 < len(data):
+        raise FormatError(
+            f"TMD file holds {len(data):,} bytes, its header describes {start + nx * ny * 4:,} "
+            f"(header and {nx} × {ny} float32 heights)"
+        )
     for name, length in (("x", length_x), ("y", length_y)):
         if not 0 < length < np.inf:
             raise FormatError(f"TMD {name} length is {length!r} µm, not a positive length")

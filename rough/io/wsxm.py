@@ -5,17 +5,27 @@ header of ``[Section]`` and ``key: value`` lines that ends with ``[Header end]``
 (``Image header size`` counts up to there, but some programs get it wrong, so the marker decides, as in
 Gwyddion). ``[General Info]`` gives ``Number of columns``/``rows`` and ``Image Data Type`` (``short`` or
 ``integer``: int16, ``float``, ``double``; little-endian), ``[Control]`` the scan size (``X Amplitude: 600
-nm``). Heights are scaled so that their range is ``[General Info] Z Amplitude`` (``13.7008 nm``): times
-Z Amplitude / (``[Miscellaneous] Maximum`` − ``Minimum``), as SurfaceTopography's ``WSXM.py`` does, or over
-the data's own range when those are missing (Gwyddion's ``wsxmfile.c`` always uses the data's range; the
-two differ by about 1e-6 relative, from the rounding of the header values).
+nm``). ``float`` and ``double`` data are heights in the unit of ``[General Info] Z Amplitude`` (``13.7008
+nm``) and are taken as stored: rescaling them to that amplitude over the header's ``Maximum`` − ``Minimum``,
+printed with six digits, moves every height by up to 1e-5 relative (SurfaceTopography's ``WSXM.py`` 1.27.1
+reads the stored values, and its test asserts stp-1.stp Sq 1.6541594 nm). Integer data are counts scaled
+so that their range is Z Amplitude: times Z Amplitude / (``[Miscellaneous] Maximum`` − ``Minimum``, whole
+counts), or over the data's own range when those are missing, as Gwyddion's ``wsxmfile.c`` does; counts
+outside Minimum … Maximum are refused (on top-1.top they are the counts' extremes). The data end the file:
+a file of another length is refused.
 
 ``Acquisition time`` (``03/11/2011, 20:23:46.484``) does not say whether the day or the month comes first,
 so it is kept as written (``wsxm_acquisition_time``), not as ``date``.
 
+The file holds one channel, named by ``[General Info] Acquisition channel``; one that is not a height
+(``Topography``, ``Height``, ``Z``), such as ``Phase`` or ``Normal force``, is refused unless ``--channel``
+names it.
+
 Orientation: as Gwyddion, which reverses both axes of the stored data (its writer does the same); row 0
 is the last line stored, column 0 the last column. SurfaceTopography keeps the stored order.
 """
+
+import re
 
 import numpy as np
 
@@ -23,7 +33,7 @@ from ..errors import FormatError, InputError
 from ..surface import Surface, Units, check_size
 from ..units import metres_per
 from .header import ini_sections
-from .registry import Format
+from .registry import Format, choose_channel
 
 FORMAT = Format(
     "wsxm",
@@ -34,6 +44,7 @@ FORMAT = Format(
 )
 
 END = b"[Header end]"
+HEIGHT = re.compile(r"topo|height|^z\b", re.IGNORECASE)
 TYPES = {"short": "<i2", "integer": "<i2", "float": "<f4", "double": "<f8"}
 
 
@@ -56,22 +67,47 @@ def read(data, options):
     dtype = np.dtype(TYPES[kind])
     if start + nx * ny * dtype.itemsize > len(data):
         raise FormatError(f"WSxM image of {nx}×{ny} {kind} values runs past the end of the file ({len(data)} bytes)")
+    if start + nx * ny * dtype.itemsize < len(data):
+        raise FormatError(
+            f"WSxM file holds {len(data):,} bytes, its header describes {start + nx * ny * dtype.itemsize:,} "
+            f"(header and {nx}×{ny} {kind} values)"
+        )
     raw = np.ndarray((ny, nx), dtype, data, start)[::-1, ::-1].astype(np.float64)
     amplitude, z_unit = _length(info, "Z Amplitude")
     control = sections.get("Control", {})
     width, xy_unit = _length(control, "X Amplitude")
     height, _ = _length(control, "Y Amplitude") if "Y Amplitude" in control else (width, xy_unit)
-    heights = raw * (amplitude / _range(sections.get("Miscellaneous", {}), raw))
+    scale = metres_per(z_unit) if dtype.kind == "f" else amplitude / _range(sections.get("Miscellaneous", {}), raw)
+    heights = raw * scale
     metadata = _metadata(info)
+    _check_height(metadata.get("channel"), options)
     return Surface(heights, (width / nx, height / ny), units=Units(xy=xy_unit, z=z_unit), metadata=metadata)
 
 
+def _check_height(channel, options):
+    """FormatError for a file whose ``Acquisition channel`` is not a height, unless ``--channel`` names it."""
+    if channel is None or HEIGHT.search(channel):
+        return
+    if options.channel is None:
+        raise FormatError(
+            f"WSxM file holds the {channel!r} channel, not heights (topography); give --channel to read it anyway"
+        )
+    choose_channel([channel], options.channel)
+
+
 def _range(miscellaneous, raw):
-    """Maximum − Minimum from the header, or the data's own range."""
+    """Maximum − Minimum from the header, or the data's own range; FormatError when a count lies outside
+    the header's Minimum … Maximum."""
     try:
-        span = float(miscellaneous["Maximum"]) - float(miscellaneous["Minimum"])
+        low, high = float(miscellaneous["Minimum"]), float(miscellaneous["Maximum"])
     except (KeyError, ValueError):
-        span = float(np.nanmax(raw) - np.nanmin(raw))
+        low, high = float(np.nanmin(raw)), float(np.nanmax(raw))
+    if raw.min() < low or raw.max() > high:
+        raise FormatError(
+            f"WSxM counts span {raw.min():g} … {raw.max():g}, outside the header's Minimum … Maximum, "
+            f"{low:g} … {high:g}: the data block is not the one the header describes"
+        )
+    span = high - low
     if not 0 < span < np.inf:
         raise FormatError(f"WSxM data range {span:g} (raw values) cannot scale the heights to their Z Amplitude")
     return span
@@ -87,7 +123,7 @@ def _length(fields, key):
         raise FormatError(f"WSxM {key} is {text!r}, not a length") from None
     if not 0 < value < np.inf:
         raise FormatError(f"WSxM {key} is {text!r}, not a positive length")
-    return value * metres, unit.strip()
+    return value * metres, unit.strip().replace("\xb5", "µ")
 
 
 def _count(fields, key):

@@ -169,7 +169,17 @@ def detrend(surface, order=2, cutoff=None, keep="roughness", ends="trim"):
     return levelled if cutoff is None else split(levelled, cutoff, keep, ends)
 
 
-def parameters(surface, cutoff=None, ends="trim", sampling_lengths=5, slope="2point", along=None, jrc_spacing=0.5e-3):
+def parameters(
+    surface,
+    cutoff=None,
+    ends="trim",
+    sampling_lengths=None,
+    slope="2point",
+    along=None,
+    jrc_spacing=0.5e-3,
+    sampling_length=None,
+    acf="iso",
+):
     """ISO parameters of a profile (Ra … JRC) or map (Sa … Std), in SI units.
 
     Computed on the data as given with the mean of the valid points removed (no
@@ -185,9 +195,10 @@ def parameters(surface, cutoff=None, ends="trim", sampling_lengths=5, slope="2po
         roughness (:func:`split`). None (the default) evaluates the data as given.
     ends : {"trim", "correct"}, default "trim"
         How the filter treats the ends (see :func:`split`); only with ``cutoff``.
-    sampling_lengths : int, default 5
-        Profiles: the number of equal sampling lengths that Rp, Rv and Rz are
-        averaged over (ISO 4287/4288).
+    sampling_lengths : int, optional
+        Profiles: the number of sampling lengths that Rp, Rv and Rz are averaged
+        over (ISO 4287/4288): by default every whole sampling length the profile
+        holds, or 5 equal sections when there is no sampling length.
     slope : {"2point", "7point"}, default "2point"
         Forward differences, or ISO 4287's seven-point derivative, for Rdq, Sdq, Sdr.
     along : {None, "x", "y"}, optional
@@ -195,6 +206,12 @@ def parameters(surface, cutoff=None, ends="trim", sampling_lengths=5, slope="2po
         own mean, and combine them.
     jrc_spacing : float, default 0.5e-3
         Profiles: the spacing in metres at which Z2 (and so JRC) is evaluated.
+    sampling_length : float, optional
+        Profiles: the sampling length lr in metres; by default ``cutoff`` (ISO 4288:
+        lr = λc). Give it to evaluate a roughness that was filtered beforehand.
+    acf : {"iso", "per-lag"}, default "iso"
+        Maps: the autocorrelation function of Sal and Str, ISO 25178-2's or the
+        mean product per lag (see :func:`rough.metrology.parameters.autocorrelation`).
 
     Returns
     -------
@@ -249,18 +266,20 @@ def parameters(surface, cutoff=None, ends="trim", sampling_lengths=5, slope="2po
     'Rq 93.7 µm'
     """
     evaluated = surface if cutoff is None else split(surface, cutoff, "roughness", ends)
+    lr = cutoff if sampling_length is None else sampling_length
     if surface.is_profile:
-        values = profile_parameters(evaluated, sampling_lengths, slope, jrc_spacing)
+        values = profile_parameters(evaluated, sampling_lengths, slope, jrc_spacing, sampling_length=lr)
     elif along is None:
-        values = areal_parameters(evaluated, slope)
+        values = areal_parameters(evaluated, slope, acf=acf)
     else:
-        values = _profiles_of_map(evaluated, along, sampling_lengths, slope, jrc_spacing)
+        values = _profiles_of_map(evaluated, along, sampling_lengths, slope, jrc_spacing, lr)
     announce_undefined(values)
     return values
 
 
 UNDEFINED = {
     "no height variation": ("Rsk", "Rku", "Ssk", "Sku", "Sal", "Str", "Std"),
+    "the profile is shorter than one sampling length, the cut-off λc": ("Rp", "Rv", "Rz", "peak_density"),
     "no profile element rises and falls 10 % of Rz across the mean line": ("RSm",),
     "the profile spans fewer than three JRC spacings": ("Z2",),
     "Z2 is zero or undefined": ("JRC",),
@@ -277,18 +296,22 @@ UNDEFINED = {
 }
 
 
-def announce_undefined(values):
+def announce_undefined(values, reasons=None):
     """One warning naming each parameter of ``values`` that came out undefined (NaN)
-    and why (Str has its own warning when Sal is defined)."""
+    and why (Str has its own warning when Sal is defined); ``reasons`` (key: reason)
+    says why for the data at hand, before the general reasons of :data:`UNDEFINED`
+    (e.g. :func:`rough.metrology.segmentation.undefined_reasons`)."""
     undefined = {key for key, value in values.items() if math.isnan(value)}
     if "Str" in undefined and "Sal" not in undefined:
         undefined.discard("Str")
-    reasons = []
-    for reason, keys in UNDEFINED.items():
-        named = [key for key in keys if key in undefined]
-        if named:
-            reasons.append(f"{', '.join(named)} ({reason})")
-    explained = {key for keys in UNDEFINED.values() for key in keys}
+    given = {key: reason for key, reason in (reasons or {}).items() if key in undefined}
+    grouped = {
+        reason: [key for key in keys if key in undefined and key not in given] for reason, keys in UNDEFINED.items()
+    }
+    for key, reason in given.items():
+        grouped.setdefault(reason, []).append(key)
+    reasons = [f"{', '.join(named)} ({reason})" for reason, named in grouped.items() if named]
+    explained = {key for keys in UNDEFINED.values() for key in keys} | set(given)
     others = sorted(undefined - explained)
     if others:
         reasons.append(
@@ -298,8 +321,11 @@ def announce_undefined(values):
         log.warning(f"undefined for this surface: {'; '.join(reasons)}")
 
 
-def _profiles_of_map(surface, along, sampling_lengths, slope, jrc_spacing):
-    each = [profile_parameters(p, sampling_lengths, slope, jrc_spacing) for p in map_profiles(surface, along)]
+def _profiles_of_map(surface, along, sampling_lengths, slope, jrc_spacing, sampling_length):
+    each = [
+        profile_parameters(p, sampling_lengths, slope, jrc_spacing, sampling_length=sampling_length)
+        for p in map_profiles(surface, along)
+    ]
     values = combined(each, PROFILE, quadratic=("Rq", "Rdq", "Z2"))
     values["JRC"] = joint_roughness_coefficient(values["Z2"])
     return values

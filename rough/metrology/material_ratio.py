@@ -6,21 +6,29 @@ and ISO 21920-2 (Rmr(c), Rmc(mr), Rδc), and ISO 25178-2:2021's areal counterpar
 The curve. The ``n`` valid heights about their mean, sorted from the highest down,
 ``h_0 ≥ … ≥ h_(n-1)``, placed at material ratios ``mr_k = 100 k / (n - 1)`` % and
 joined by straight lines: ``h(0 %)`` is the highest point and ``h(100 %)`` the
-lowest. Smc(mr) reads the curve; Smr(c) inverts it, and where several points share
-the height ``c`` (quantised data) it counts them all as material (the largest
-ratio). Sampling the curve at every point, rather than in classes, makes every
-parameter exact for the data; surfalize samples it at 10 000 classes.
+lowest. The mean is that of the sorted heights, so the curve and every parameter
+below depend on the valid heights only, not on their order nor on where invalid
+points lie. Smc(mr) reads the curve; Smr(c) inverts it, and where several points
+share the height ``c`` (quantised data) it counts them all as material (the largest
+ratio); a point within the heights' rounding of ``c`` is at ``c``. The heights'
+rounding is ``ROUNDING`` (64 eps) times the largest absolute height as given: what
+storing and centring them leaves, with a wide margin. Sampling the curve at every
+point, rather than in classes, makes every parameter exact for the data; surfalize
+samples it at 10 000 classes.
 
 The core (ISO 13565-2 §4; ISO 25178-2:2021 Annex B). The *central region* is the
-40 % wide window of material ratio whose secant drops least (the first such window
-on ties). The *equivalent straight line* is the least-squares line ``h = a + b·mr``
+40 % wide window of material ratio whose secant drops least. Windows whose drops
+exceed the least by no more than the heights' rounding are tied (quantised heights
+tie windows exactly, and rounding alone would choose), and the central region is the
+first of them, at the lowest material ratio, as ISO 13565-2 takes the first of equal
+windows. The *equivalent straight line* is the least-squares line ``h = a + b·mr``
 through the curve's points in that window (the secant itself when the window holds
-fewer than two points). It meets 0 % at ``c1 = a`` and 100 % at
-``c2 = a + 100 b``: Sk = c1 - c2, Smr1 = Smr(c1), Smr2 = Smr(c2). A1 is the area
-between the curve and the level ``c1`` over ``0 … Smr1`` and A2 that between the level
-``c2`` and the curve over ``Smr2 … 100 %`` (both in height × %, integrated exactly
-on the piecewise-linear curve); Spk = 2 A1 / Smr1 and Svk = 2 A2 / (100 % - Smr2),
-the heights of triangles of equal area, and 0 when Smr1 = 0 or Smr2 = 100 %.
+fewer than two points). It meets 0 % at ``c1 = a`` and 100 % at ``c2 = a + 100 b``:
+Sk = c1 - c2, Smr1 = Smr(c1), Smr2 = Smr(c2). A1 is the area between the curve and
+the level ``c1`` over ``0 … Smr1`` and A2 that between the level ``c2`` and the curve
+over ``Smr2 … 100 %`` (both in height × %, integrated exactly on the
+piecewise-linear curve); Spk = 2 A1 / Smr1 and Svk = 2 A2 / (100 % - Smr2), the
+heights of triangles of equal area, and 0 when Smr1 = 0 or Smr2 = 100 %.
 
 Volumes (ISO 25178-2 §4.4), per unit area, in m³/m² (1 m³/m² = 10⁶ ml/m²):
 ``Vm(mr) = ∫_0^mr (h(q) - h(mr)) dq / 100 %``, the material above the level
@@ -33,10 +41,12 @@ The normal-probability curve (ISO 13565-3). Heights against the standard normal
 deviate of their material ratio (Hazen positions ``(k + ½)/n``), within ±3 standard
 deviations. A stratified surface gives two straight lines: the plateau (upper) and
 the valley (lower) process. rough fits both at once, as the continuous two-line
-least-squares fit whose break minimises the residual: Rpq and Rvq are the slopes
-of the plateau and valley lines (the Rq of each process), Rmq the material ratio
-of the break, in %. ISO 13565-3 fixes the two regions by other rules; on an exact
-two-process surface both give its two Rq and its transition.
+least-squares fit whose break minimises the residual (of breaks whose residuals
+exceed the least by no more than ``ROUNDING`` times the sum of squared heights, the
+one at the lowest deviate): Rpq and Rvq are the slopes of the plateau and valley
+lines (the Rq of each process), Rmq the material ratio of the break, in %. ISO
+13565-3 fixes the two regions by other rules; on an exact two-process surface both
+give its two Rq and its transition.
 
 Every function here uses the valid (non-NaN) points only.
 """
@@ -191,16 +201,17 @@ class MaterialRatioCurve:
     """
 
     def __init__(self, surface):
-        heights, total = valid_values(np.asarray(getattr(surface, "heights", surface), dtype=np.float64))
+        heights, _ = valid_values(np.asarray(getattr(surface, "heights", surface), dtype=np.float64))
         if heights.size < 2:
             raise InputError("the material-ratio curve needs at least two valid points")
-        ordered = total / heights.size - heights  # one new array: sorted in place, turned descending
+        ordered = np.negative(heights)  # one new array: sorted ascending, it runs from the highest point down
         ordered.sort()
+        self._rounding = ROUNDING * max(abs(float(ordered[0])), abs(float(ordered[-1])))
+        ordered -= ordered.sum() / ordered.size  # the mean of the sorted heights: the same for any order of the points
         np.negative(ordered, out=ordered)
         ordered += 0.0  # -0.0 to 0.0
         self.heights = ordered
         self.ratios = np.linspace(0.0, 100.0, heights.size)
-        self._rounding = ROUNDING * max(abs(float(ordered[0])), abs(float(ordered[-1])))
 
     @functools.cached_property
     def _integral(self):
@@ -266,31 +277,48 @@ class MaterialRatioCurve:
         """The ISO 13565-2 construction: the 40 % central region of least secant
         gradient, its least-squares equivalent straight line and the areas A1, A2.
 
+        Of windows whose drops differ from the least by no more than the rounding of
+        the heights (:data:`ROUNDING` times the largest absolute height as given),
+        the first, at the lowest material ratio, is the central region.
+
         Returns
         -------
         Core
         """
-        first, drop = 0, math.inf  # the first window of least drop, found a block at a time
-        windows = int(np.searchsorted(self.ratios, 100.0 - CENTRAL_REGION, side="right"))
-        for top in range(0, windows, BLOCK):
-            starts = self.ratios[top : min(top + BLOCK, windows)]
-            drops = self.heights[top : top + starts.size] - np.interp(
-                starts + CENTRAL_REGION, self.ratios, self.heights
-            )
-            least = int(np.argmin(drops))
-            if drops[least] < drop:
-                first, drop = top + least, float(drops[least])
-        start = self.ratios[first]
-        end = np.searchsorted(self.ratios, start + CENTRAL_REGION, side="right")
-        if end - first > 1:
-            slope, intercept = _line(self.ratios[first:end], self.heights[first:end])
+        n = self.heights.size
+        points, fifths = divmod(2 * (n - 1), 5)  # the window spans points + fifths/5 intervals of the curve
+        first = self._central_region(points, fifths)
+        start = float(self.ratios[first])
+        if points:
+            slope, top, bottom = _central_line(self.heights[first : first + points + 1], first, n)
         else:  # fewer than two points in the window (fewer than four in all): the secant
-            slope = -drop / CENTRAL_REGION
-            intercept = float(self.heights[first]) - slope * start
-        top, bottom = intercept, intercept + 100.0 * slope
+            slope = -float(self._drops(first, first + 1, points, fifths)[0]) / CENTRAL_REGION
+            top = float(self.heights[first]) - slope * start
+            bottom = top + 100.0 * slope
         mr1, mr2 = float(self._ratio(top, "left")), float(self._ratio(bottom, "right"))
         peak_area, valley_area = self._excess(mr1, top), self._deficit(mr2, bottom)
         return Core(top, bottom, slope, (start, start + CENTRAL_REGION), mr1, mr2, peak_area, valley_area)
+
+    def _central_region(self, points, fifths):
+        """The first point of the central region: of the windows starting at every
+        point up to 60 %, the first whose secant drop is within :attr:`_rounding` of
+        the least (drops that close are equal to the precision of the heights)."""
+        windows = (3 * (self.heights.size - 1)) // 5 + 1
+        blocks = [(top, min(top + BLOCK, windows)) for top in range(0, windows, BLOCK)]
+        least = min(float(self._drops(top, stop, points, fifths).min()) for top, stop in blocks)
+        tied = (self._drops(top, stop, points, fifths) <= least + self._rounding for top, stop in blocks)
+        return next(top + int(np.argmax(close)) for (top, _), close in zip(blocks, tied) if close.any())
+
+    def _drops(self, top, stop, points, fifths):
+        """The secant drops ``h(mr) - h(mr + 40 %)`` of the windows starting at the
+        points ``top … stop - 1``, ``points + fifths/5`` points long: the same sum of
+        two non-negative differences of sorted heights for every window."""
+        h = self.heights
+        end = h[top + points : stop + points]
+        drops = h[top:stop] - end
+        if fifths:
+            drops += fifths / 5 * (end - h[top + points + 1 : stop + points + 1])
+        return drops
 
     def probability(self):
         """ISO 13565-3: the continuous two-line least-squares fit to the heights against
@@ -324,11 +352,19 @@ def _check_ratio(ratio):
         raise InputError(f"a material ratio must lie between 0 and 100 %, not {ratio}")
 
 
-def _line(x, y):
-    """Least-squares ``y = intercept + slope·x``: ``(slope, intercept)``."""
-    xm, ym = x.mean(), y.mean()
-    slope = float(np.sum((x - xm) * (y - ym)) / np.sum((x - xm) ** 2))
-    return slope, float(ym - slope * xm)
+def _central_line(heights, first, n):
+    """The least-squares line through the ``m`` points ``first …`` of a curve of ``n``,
+    ``heights`` (sorted from the highest down), as ``(slope, top, bottom)``: metres
+    per %, and its heights at 0 % and 100 %. Its gradient per point is
+    ``Σ (i - i0)(h_i - h_(m-1-i)) / Σ (i - i0)²`` over the first half of the window
+    about its centre ``i0``: exact offsets and differences of one sign, so no
+    cancellation, and exactly 0 on a level window."""
+    m = heights.size
+    offsets = np.arange(m // 2) - (m - 1) / 2
+    gaps = heights[: m // 2] - heights[::-1][: m // 2]
+    per_point = float(np.sum(offsets * gaps)) / (m * (m * m - 1) / 12)
+    centre, level = first + (m - 1) / 2, float(heights.mean())
+    return per_point * (n - 1) / 100, level - per_point * centre, level + per_point * (n - 1 - centre)
 
 
 def _two_lines(q, h):
@@ -347,17 +383,23 @@ def _two_lines(q, h):
     for name, values in _moments(q, h):
         sums[name] = _cumulative(values)[ends - 1]
         del values  # before the next moment is made
+    tolerance = ROUNDING * float(sums["hh"][-1])  # residuals this close are equal to the precision of the sums
     residual, _ = _broken_lines(q, sums, ends)
-    best = int(np.argmin(residual))
+    best = _first_least(residual, tolerance)
     before = max(0, best - 1)  # the window starts at a coarse break, whose running sums are known
     fine = np.arange(coarse[before], min(n - least, coarse[best] + stride + 1))
     window = slice(fine[0], fine[-1])
     sums = {name: _running(values, sums[name][before], sums[name][-1]) for name, values in _moments(q, h, window)}
     residual, coefficients = _broken_lines(q, sums, np.append(fine, n))
-    best = int(np.argmin(residual))
+    best = _first_least(residual, tolerance)
     intercept, valley, plateau = coefficients[best]
     deviate = float(q[fine[best]])
     return ProbabilityFit(float(plateau), float(valley), float(100.0 * ndtr(-deviate)), deviate, float(intercept))
+
+
+def _first_least(values, tolerance):
+    """The index of the first of ``values`` within ``tolerance`` of the least."""
+    return int(np.argmax(values <= values.min() + tolerance))
 
 
 def _cumulative(values):

@@ -20,9 +20,13 @@ valid (non-NaN) points only:
   above the band after being below it), per metre of evaluation length;
 - Z2 is Tse & Cruden's RMS first derivative of the profile sampled at
   ``jrc_spacing`` (0.5 mm by default), and JRC = 32.2 + 32.47 log10(Z2);
-- Sal and Str come from the autocorrelation function computed over pairs of valid
-  points only (no filling), Std from the Hann-windowed power spectrum; Std is the
-  direction of the lay (the ridges), counter-clockwise from +x, in [0°, 180°).
+- Sal and Str come from the autocorrelation function over pairs of valid points
+  only (no filling): by default ISO 25178-2's, the sum of the products of the
+  pairs at each lag over the sum of the squares (``acf="iso"``), or the mean product
+  of the pairs at each lag over the mean square (``acf="per-lag"``, surfalize's and
+  the statistician's unbiased estimate); Std from the Hann-windowed power
+  spectrum; Std is the direction of the lay (the ridges), counter-clockwise from
+  +x, in [0°, 180°).
 """
 
 import logging
@@ -31,11 +35,15 @@ import math
 import numpy as np
 
 from ..errors import InputError
+from ..units import format_length
 
 log = logging.getLogger("rough")
 
 SLOPES = ("2point", "7point")
+ACFS = ("iso", "per-lag")
 SEVEN_POINT = np.array([1.0, -9.0, 45.0, 0.0, -45.0, 9.0, -1.0]) / 60.0
+MAGNITUDE = 1e60  # m: heights up to this keep every power and sum the parameters take within float64
+SAMPLING_TOLERANCE = 0.01  # a profile within 1 % of a whole number of sampling lengths holds that many
 ROUNDING = 64 * np.finfo(float).eps  # relative: deviations this small are the rounding of the mean (measured ≤ 2.3 eps)
 BLOCK = 1 << 16  # points per block when streaming through a map: cache-sized, no full-size temporaries
 FFT_BLOCK = 1 << 18  # points per block of 1-D transforms: few calls, a few MB of scratch
@@ -77,10 +85,11 @@ def valid_values(heights):
     without a copy, when there is no NaN) and their sum, the very one ``values.sum()``
     and ``values.mean()`` take."""
     values = heights.reshape(-1)
-    total = values.sum()
-    if not math.isfinite(total):
-        values = values[~np.isnan(values)]
+    with np.errstate(over="ignore", invalid="ignore"):  # a sum beyond float64 is refused by centring
         total = values.sum()
+        if not math.isfinite(total):
+            values = values[~np.isnan(values)]
+            total = values.sum()
     return values, total
 
 
@@ -88,12 +97,25 @@ def centring(heights):
     """``(mean, count, constant)`` of the valid points of ``heights``: their mean and
     number, and whether they differ from that mean only by its rounding (a constant
     surface, whose deviations count as exactly zero). Reads a NaN-free array without
-    copying it."""
+    copying it.
+
+    Raises
+    ------
+    rough.InputError
+        For a height beyond ±1e60 m (:data:`MAGNITUDE`), where the powers and sums
+        that the parameters take would overflow float64 (to inf or NaN).
+    """
     values, total = valid_values(heights)
     if not values.size:
         return math.nan, 0, False
+    top, bottom = float(values.max()), float(values.min())
+    if not max(top, -bottom) <= MAGNITUDE:
+        raise InputError(
+            f"a height of {top if top > -bottom else bottom:.6g} m is beyond ±{MAGNITUDE:g} m, where the "
+            "parameters' sums of powers overflow: the data are damaged, or their unit is wrong"
+        )
     mean = total / values.size
-    return mean, values.size, max(values.max() - mean, mean - values.min()) <= ROUNDING * abs(mean)
+    return mean, values.size, max(top - mean, mean - bottom) <= ROUNDING * abs(mean)
 
 
 def centred(heights):
@@ -157,7 +179,9 @@ def _check_slope(method, points):
         raise InputError("the seven-point slope needs at least 7 points along each axis")
 
 
-def profile_parameters(surface, sampling_lengths=5, slope="2point", jrc_spacing=0.5e-3, peak_band=0.05):
+def profile_parameters(
+    surface, sampling_lengths=None, slope="2point", jrc_spacing=0.5e-3, peak_band=0.05, sampling_length=None
+):
     """ISO 4287/4288 parameters of a profile, and Tse & Cruden's Z2 and JRC.
 
     On the data as given, about the mean of the valid points (no levelling, no
@@ -169,9 +193,11 @@ def profile_parameters(surface, sampling_lengths=5, slope="2point", jrc_spacing=
         A profile. NaN points are left out: amplitude parameters use the valid
         points, slopes pairs of neighbouring valid points, RSm and the peak count
         close up the gaps, and Z2 interpolates linearly between valid points.
-    sampling_lengths : int, default 5
-        The number of equal sampling lengths over which Rp, Rv and Rz are taken and
-        averaged (ISO 4287/4288).
+    sampling_lengths : int, optional
+        The number of sampling lengths over which Rp, Rv and Rz are taken and
+        averaged (ISO 4287/4288). Without ``sampling_length``: that many equal
+        sections (5 by default). With it: that many sampling lengths in the middle
+        of the profile (by default every whole one it holds).
     slope : {"2point", "7point"}, default "2point"
         Forward differences (SurfaceTopography's and surfalize's definition), or
         ISO 4287's seven-point derivative on interior points, for Rdq.
@@ -181,6 +207,9 @@ def profile_parameters(surface, sampling_lengths=5, slope="2point", jrc_spacing=
     peak_band : float, default 0.05
         Half-width of the band about the mean line for the peak count, as a fraction
         of Rz (ISO 4287/Amd.1's RPc rule).
+    sampling_length : float, optional
+        The sampling length lr in metres; ISO 4288 takes lr = λc, the cut-off of
+        the roughness filter. See :func:`sampling_sections`.
 
     Returns
     -------
@@ -188,14 +217,17 @@ def profile_parameters(surface, sampling_lengths=5, slope="2point", jrc_spacing=
         Keyed as :data:`PROFILE`: Ra, Rq, Rt, Rp, Rv, Rz, RSm (m); Rsk, Rku, Rdq,
         Z2, JRC (pure numbers); ``peak_density`` (1/m). NaN where a parameter is
         undefined: Rsk and Rku of a constant profile, RSm with no complete profile
-        element, Z2 over fewer than three JRC spacings, JRC unless Z2 > 0.
+        element, Z2 over fewer than three JRC spacings, JRC unless Z2 > 0; Rp, Rv,
+        Rz, RSm and ``peak_density`` of a profile shorter than one
+        ``sampling_length``.
 
     Raises
     ------
     rough.InputError
         For a profile with no valid points, an unknown ``slope``, fewer than 7
-        points for the seven-point slope, or more sampling lengths than half the
-        points.
+        points for the seven-point slope, more equal sampling lengths than half the
+        points, or more sampling lengths of ``sampling_length`` than the profile
+        holds.
 
     See Also
     --------
@@ -236,9 +268,11 @@ def profile_parameters(surface, sampling_lengths=5, slope="2point", jrc_spacing=
     dx = surface.spacing[0]
     levels = centred(z)
     moments = amplitude(z)
-    rp, rv = _per_sampling_length(levels, sampling_lengths)
+    sections = sampling_sections(z.size, dx, sampling_length, sampling_lengths)
+    rp, rv = _per_sampling_length(levels, sections)
     rz = rp + rv
     length = z.size * dx
+    lr = sampling_length if sampling_length is not None else length / len(sections)
     slope_values = slopes(z, dx, slope)
     z2 = _z2(surface, jrc_spacing)
     return {
@@ -250,15 +284,15 @@ def profile_parameters(surface, sampling_lengths=5, slope="2point", jrc_spacing=
         "Rv": rv,
         "Rz": rz,
         "Rt": moments["p"] + moments["v"],
-        "RSm": mean_element_width(levels, dx, rz, length / sampling_lengths),
+        "RSm": mean_element_width(levels, dx, rz, lr),
         "Rdq": _rms(slope_values),
-        "peak_density": peak_count(levels, peak_band * rz) / length,
+        "peak_density": peak_count(levels, peak_band * rz) / length if sections else math.nan,
         "Z2": z2,
         "JRC": joint_roughness_coefficient(z2),
     }
 
 
-def areal_parameters(surface, slope="2point", threshold=0.2):
+def areal_parameters(surface, slope="2point", threshold=0.2, acf="iso"):
     """ISO 25178-2 areal parameters of a map.
 
     On the data as given, about the mean of the valid points (no levelling, no
@@ -274,6 +308,10 @@ def areal_parameters(surface, slope="2point", threshold=0.2):
         Forward differences, or ISO 4287's seven-point derivative, for Sdq and Sdr.
     threshold : float, default 0.2
         The autocorrelation level that defines Sal and Str.
+    acf : {"iso", "per-lag"}, default "iso"
+        The autocorrelation function of Sal and Str: ISO 25178-2's (the products
+        of the pairs at each lag summed, over the sum of the squares) or the mean
+        product per lag over the mean square. See :func:`autocorrelation`.
 
     Returns
     -------
@@ -287,8 +325,8 @@ def areal_parameters(surface, slope="2point", threshold=0.2):
     Raises
     ------
     rough.InputError
-        For a map with no valid points, an unknown ``slope``, or fewer than 7 points
-        along an axis for the seven-point slope.
+        For a map with no valid points, an unknown ``slope`` or ``acf``, or fewer
+        than 7 points along an axis for the seven-point slope.
 
     See Also
     --------
@@ -329,11 +367,11 @@ def areal_parameters(surface, slope="2point", threshold=0.2):
 
     >>> values = areal_parameters(rough.read(rough.sample("rock-map.x3p")))
     >>> print(f"Sq {values['Sq'] * 1e6:.1f} µm, Sal {values['Sal'] * 1e3:.2f} mm, Str {values['Str']:.2f}")
-    Sq 100.0 µm, Sal 0.86 mm, Str 0.73
+    Sq 100.0 µm, Sal 0.80 mm, Str 0.73
     """
     moments = amplitude(surface.heights)
     sdq, sdr = gradient_means(surface, slope)
-    sal, str_ratio = autocorrelation_lengths(surface, threshold)
+    sal, str_ratio = autocorrelation_lengths(surface, threshold, acf=acf)
     return {
         "Sa": moments["a"],
         "Sq": moments["q"],
@@ -435,7 +473,7 @@ def amplitude_density(surface, bins=50):
     >>> round(float(np.sum(density) * (centres[1] - centres[0])), 9)  # integrates to 1
     1.0
     """
-    values = surface.heights[~np.isnan(surface.heights)]
+    values = np.sort(surface.heights[~np.isnan(surface.heights)])  # the mean, and so the bins, order-free
     density, edges = np.histogram(values - values.mean(), bins=bins, density=True)
     return (edges[:-1] + edges[1:]) / 2, density
 
@@ -445,16 +483,74 @@ def _rms(values):
     return float(math.sqrt(np.mean(finite**2))) if finite.size else math.nan
 
 
-def _per_sampling_length(centred, count):
-    """Rp and Rv in each of ``count`` equal sampling lengths, averaged."""
-    if count < 1 or count > centred.size // 2:
-        raise InputError(f"cannot split {centred.size} points into {count} sampling lengths")
+def sampling_sections(points, spacing, sampling_length=None, count=None):
+    """The sampling lengths of a profile of ``points`` samples ``spacing`` apart, as
+    ``(start, stop)`` index ranges.
+
+    Without ``sampling_length``: ``count`` (default 5) equal sections of the whole
+    profile. With it (ISO 4288: lr = λc): ``count`` sampling lengths of that length,
+    by default every whole one the profile holds, taken in the middle of the profile
+    (what is left over is dropped equally at both ends). A profile within 1 % of a
+    whole number of sampling lengths holds that many, split equally (instruments
+    store whole samples per sampling length, and the trimmed ends of a filter round
+    to whole samples). An empty list when the profile is shorter than one sampling
+    length.
+
+    Raises
+    ------
+    rough.InputError
+        For fewer than one or more than ``points // 2`` equal sections, a sampling
+        length of fewer than two samples, or more sampling lengths than the profile
+        holds.
+
+    Examples
+    --------
+    A 10 mm profile at 1.5 µm holds four sampling lengths of λc = 2.5 mm:
+
+    >>> from rough.metrology.parameters import sampling_sections
+    >>> sampling_sections(6664, 1.5e-6, 2.5e-3)
+    [(0, 1666), (1666, 3332), (3332, 4998), (4998, 6664)]
+    >>> sampling_sections(10, 1.0, None, 2)
+    [(0, 5), (5, 10)]
+    """
+    if sampling_length is None:
+        count = 5 if count is None else count
+        if count < 1 or count > points // 2:
+            raise InputError(f"cannot split {points} points into {count} sampling lengths")
+        return _equal_parts(0, points, count)
+    per = sampling_length / spacing
+    if not per >= 2:
+        raise InputError(f"a sampling length of {format_length(sampling_length)} holds fewer than two samples")
+    whole = math.floor(points / per + SAMPLING_TOLERANCE)
+    if count is None:
+        count = whole
+    elif not 1 <= count <= whole:
+        raise InputError(f"the profile holds {whole} sampling lengths of {format_length(sampling_length)}, not {count}")
+    span = min(points, round(count * per))
+    return _equal_parts((points - span) // 2, span, count) if count else []
+
+
+def _equal_parts(start, length, count):
+    """``count`` consecutive index ranges over ``length`` points from ``start``, as
+    ``numpy.array_split`` cuts them (the first ``length % count`` one point longer)."""
+    sizes = np.full(count, length // count)
+    sizes[: length % count] += 1
+    bounds = start + np.concatenate(([0], np.cumsum(sizes)))
+    return [(int(a), int(b)) for a, b in zip(bounds[:-1], bounds[1:])]
+
+
+def _per_sampling_length(centred, sections):
+    """Rp and Rv in each sampling length (``(start, stop)`` index ranges), averaged
+    over those with valid points; NaN when there are none."""
     peaks, valleys = [], []
-    for part in np.array_split(centred, count):
+    for start, stop in sections:
+        part = centred[start:stop]
         part = part[~np.isnan(part)]
         if part.size:
             peaks.append(part.max())
             valleys.append(-part.min())
+    if not peaks:
+        return math.nan, math.nan
     return float(np.mean(peaks)), float(np.mean(valleys))
 
 
@@ -512,30 +608,68 @@ def _z2(surface, jrc_spacing):
     return float(math.sqrt(np.mean(np.diff(heights) ** 2)) / step)
 
 
-def autocorrelation(surface):
-    """The normalised autocorrelation of the mean-removed valid heights, over pairs
-    of valid points only, on lags up to half the map in each direction: returns
-    ``(acf, lag_x, lag_y)`` with ``acf[j, i]`` at lag ``(lag_x[i], lag_y[j])``.
+def autocorrelation(surface, acf="iso"):
+    """The normalised autocorrelation of the mean-removed valid heights ``z``, over
+    pairs of valid points only, on lags up to half the map in each direction.
 
+    Parameters
+    ----------
+    surface : Surface
+        A map; NaN points are in no pair (no filling).
+    acf : {"iso", "per-lag"}, default "iso"
+        ``iso``: ISO 25178-2's ``∬ z(x, y) z(x - tx, y - ty) dx dy / ∬ z² dx dy`` over
+        the definition area, the sum of the products of the pairs at each lag over
+        the sum of the squares; it falls towards 0 as the overlap shrinks.
+        ``per-lag``: the mean product of the pairs at each lag over the mean
+        square (the unbiased estimate that surfalize uses); noisier at long lags,
+        NaN where no pair is valid.
+
+    Returns
+    -------
+    acf : numpy.ndarray
+        ``acf[j, i]`` at lag ``(lag_x[i], lag_y[j])``; 1 at zero lag; NaN for a
+        constant map.
+    lag_x, lag_y : numpy.ndarray
+        The lags in metres, -nx//2 … nx//2 and -ny//2 … ny//2 spacings.
+
+    Notes
+    -----
     Computed through zero-padded FFTs a block at a time, only the lags needed (one
     half plane; the other is its mirror image), so that it never holds more than
-    about 2.7 times the map's size."""
+    about 2.7 times the map's size.
+
+    Examples
+    --------
+    Heights alternating +1, -1 along x: at a lag of one spacing every pair has
+    product -1, so the per-lag ACF is -1 and ISO's is -(nx - 1)/nx.
+
+    >>> import numpy as np
+    >>> import rough
+    >>> from rough.metrology.parameters import autocorrelation
+    >>> stripes = rough.Surface(np.tile([1.0, -1.0], (4, 4)), 1.0)  # 4 × 8
+    >>> float(autocorrelation(stripes, "per-lag")[0][2, 5]), float(autocorrelation(stripes)[0][2, 5])
+    (-1.0, -0.875)
+    """
+    if acf not in ACFS:
+        raise InputError(f"acf must be one of {', '.join(ACFS)}, not {acf!r}")
     z = surface.heights
     ny, nx = z.shape
     hy, hx = ny // 2, nx // 2
     mean, count, constant = centring(z)
     products = _half_correlation(lambda rows: _deviation(z[rows], mean, constant), z.shape)
-    if count == z.size:
+    if acf == "iso":
+        pairs = np.ones_like(products)
+    elif count == z.size:
         pairs = np.outer(ny - np.arange(hy + 1.0), nx - np.abs(np.arange(-hx, hx + 1.0)))
     else:
         pairs = np.rint(_half_correlation(lambda rows: (~np.isnan(z[rows])).astype(np.float64), z.shape))
-    acf = np.empty((2 * hy + 1, 2 * hx + 1))
+    result = np.empty((2 * hy + 1, 2 * hx + 1))
     with np.errstate(invalid="ignore", divide="ignore"):
-        np.divide(products, pairs, out=acf[hy:])
-        acf[hy:][pairs == 0] = np.nan  # no pair of valid points at this lag (not the rounding of the FFTs)
-        acf[hy:] /= acf[hy, hx]
-    acf[:hy] = acf[:hy:-1, ::-1]  # the autocorrelation of a real field: acf(-l) = acf(l)
-    return acf, np.arange(-hx, hx + 1) * surface.spacing[0], np.arange(-hy, hy + 1) * surface.spacing[1]
+        np.divide(products, pairs, out=result[hy:])
+        result[hy:][pairs == 0] = np.nan  # no pair of valid points at this lag (not the rounding of the FFTs)
+        result[hy:] /= result[hy, hx]
+    result[:hy] = result[:hy:-1, ::-1]  # the autocorrelation of a real field: acf(-l) = acf(l)
+    return result, np.arange(-hx, hx + 1) * surface.spacing[0], np.arange(-hy, hy + 1) * surface.spacing[1]
 
 
 def _deviation(heights, mean, constant):
@@ -584,13 +718,14 @@ def _half_correlation(field, shape):
     return np.concatenate([correlation[:, px - hx :], correlation[:, : hx + 1]], axis=1)
 
 
-def autocorrelation_lengths(surface, threshold=0.2, directions=360):
+def autocorrelation_lengths(surface, threshold=0.2, directions=360, acf="iso"):
     """Sal (the shortest lag at which the ACF falls to ``threshold``) and Str (Sal over
-    the longest such decay length among all directions). Lags reach half the map
-    along each axis; Str is NaN when the ACF does not fall to ``threshold`` within
-    that in some direction (the texture is longer than half the map); both are NaN
-    for a constant surface."""
-    acf, lag_x, lag_y = autocorrelation(surface)
+    the longest such decay length among all directions), with the autocorrelation
+    ``acf`` of :func:`autocorrelation` (ISO 25178-2's by default). Lags reach half the
+    map along each axis; Str is NaN when the ACF does not fall to ``threshold``
+    within that in some direction (the texture is longer than half the map); both
+    are NaN for a constant surface."""
+    acf, lag_x, lag_y = autocorrelation(surface, acf)
     dx, dy = surface.spacing
     centre = ((acf.shape[0] - 1) / 2, (acf.shape[1] - 1) / 2)
     finest = min(dx, dy) / 4

@@ -37,9 +37,12 @@ Definitions (heights are about the mean of the valid points, as everywhere in
 - The parameters count the significant hills (dales); with ``edges="exclude"``
   (the default) the edge motifs are left out. Spd is their number per unit area
   of the map (nx·dx · ny·dy); Spc the mean curvature of their peaks; S5p the mean
-  height of the five highest peaks and S5v the mean depth of the five deepest pits
-  (fewer when fewer are counted), S10z = S5p + S5v; Sha, Sda the mean area and Shv,
-  Sdv the mean volume of the counted hills, dales.
+  height of the five highest peaks and S5v the mean depth of the five deepest pits,
+  S10z = S5p + S5v; with fewer than five counted hills (dales) ISO 25178-2 does
+  not define them and they are NaN (:func:`undefined_reasons` names the count).
+  Heights are about the mean plane, so a tilted or curved map can give peaks below
+  it: a negative S5p (S5v) is reported with a warning. Sha, Sda the mean area and
+  Shv, Sdv the mean volume of the counted hills, dales.
 
 Invalid (NaN) points belong to no motif (label 0): water does not flow through
 them, so they split motifs as the border does, and the motifs that touch them are
@@ -55,6 +58,7 @@ import numpy as np
 from ..errors import InputError
 from .parameters import centred
 
+FIVE = 5  # S5p, S5v: the mean of ISO 25178-2's five highest peaks, five deepest pits
 # key: (unit, what it is), as rough.metrology.parameters.AREAL.
 FEATURE = {
     "Spd": ("1/m2", "density of peaks: significant hills per area"),
@@ -280,9 +284,11 @@ def feature_parameters(surface, pruning=5.0, edges="exclude"):
     dict of str to float
         Keyed as :data:`FEATURE`: Spd (1/m²), Spc (1/m), S5p, S5v, S10z (m), Sda,
         Sha (m²), Sdv, Shv (m³). Spd is 0 when no hill is counted; the others are
-        NaN where they are undefined: with no counted hill (Spc, S5p, Sha, Shv) or
-        dale (S5v, Sda, Sdv), S10z unless both S5p and S5v are defined, and Spc when
-        no counted peak is away from the border and invalid points.
+        NaN where they are undefined: with no counted hill (Spc, Sha, Shv) or dale
+        (Sda, Sdv), with fewer than five counted hills (S5p) or dales (S5v), S10z
+        unless both S5p and S5v are defined, and Spc when no counted peak is away
+        from the border and invalid points. A negative S5p or S5v (peaks below, pits
+        above the mean plane: a tilted or curved map) is logged as a warning.
 
     Raises
     ------
@@ -299,13 +305,14 @@ def feature_parameters(surface, pruning=5.0, edges="exclude"):
     -----
     With ``edges="exclude"`` a map that holds only one hill across its whole area
     (a single bump) has no complete hill: Spd = 0 and S5p is NaN;
-    ``edges="include"`` counts it.
+    ``edges="include"`` counts it (S5p is still NaN: one hill is not five).
 
     Examples
     --------
     The egg-box surface of :func:`segment`, A = 1 µm: 4 complete hills and 9
     complete dales on 36 µm × 36 µm, the peaks 2 µm high, the pits (between points)
-    2 cos(π/9) µm deep.
+    2 cos(π/9) µm deep. Four hills are fewer than the five S5p averages, so S5p and
+    S10z are undefined unless the edge hills are counted too.
 
     >>> import numpy as np
     >>> import rough
@@ -315,7 +322,10 @@ def feature_parameters(surface, pruning=5.0, edges="exclude"):
     >>> values = feature_parameters(egg_box)
     >>> print(f"Spd {values['Spd'] * 36e-6**2:.0f} per map, S5p {values['S5p'] * 1e6:.3f} µm, "
     ...       f"S5v {values['S5v'] * 1e6:.3f} µm, S10z {values['S10z'] * 1e6:.3f} µm")
-    Spd 4 per map, S5p 2.000 µm, S5v 1.879 µm, S10z 3.879 µm
+    Spd 4 per map, S5p nan µm, S5v 1.879 µm, S10z nan µm
+    >>> values = feature_parameters(egg_box, edges="include")
+    >>> print(f"S5p {values['S5p'] * 1e6:.3f} µm, S10z {values['S10z'] * 1e6:.3f} µm")
+    S5p 2.000 µm, S10z 3.879 µm
     >>> print(f"Sha {values['Sha'] * 1e12:.0f} µm², Shv {values['Shv'] * 1e18:.1f} µm³")
     Sha 81 µm², Shv 30.7 µm³
     """
@@ -350,7 +360,7 @@ def motif_parameters(surface, hills, dales, edges="exclude"):
     >>> u = 2 * np.pi * (np.arange(36) - 4) / 9
     >>> egg_box = rough.Surface(1e-6 * (np.cos(u)[None, :] + np.cos(u)[:, None]), 1e-6)
     >>> hills, dales = segment(egg_box, "hills"), segment(egg_box, "dales")
-    >>> motif_parameters(egg_box, hills, dales) == feature_parameters(egg_box)
+    >>> motif_parameters(egg_box, hills, dales, "include") == feature_parameters(egg_box, edges="include")
     True
     """
     _check_edges(edges)
@@ -358,8 +368,15 @@ def motif_parameters(surface, hills, dales, edges="exclude"):
     nx, ny = surface.points
     dx, dy = surface.spacing
     curvatures = [hill.curvature for hill in hills if math.isfinite(hill.curvature)]
-    s5p = _mean(sorted((hill.height for hill in hills), reverse=True)[:5])
-    s5v = _mean(sorted((-dale.height for dale in dales), reverse=True)[:5])
+    s5p = _five_point([hill.height for hill in hills])
+    s5v = _five_point([-dale.height for dale in dales])
+    below = [f"{key} = {value:.4g} m" for key, value in (("S5p", s5p), ("S5v", s5v)) if value < 0]
+    if below:
+        log.warning(
+            "%s: the five highest peaks lie below (or deepest pits above) the mean plane on average; "
+            "on a tilted or curved map, detrend first",
+            ", ".join(below),
+        )
     return {
         "Spd": len(hills) / (nx * dx * ny * dy),
         "Spc": _mean(curvatures),
@@ -746,6 +763,35 @@ def _check_edges(edges):
 def _counted(segmentation, edges):
     """The motifs the parameters count: all, or those that are not edge motifs."""
     return [motif for motif in segmentation.motifs if edges == "include" or not motif.edge]
+
+
+def undefined_reasons(hills, dales, edges="exclude"):
+    """Why S5p and S5v are undefined for these motifs, naming the count:
+    ``{key: reason}`` for each of them that has fewer than five counted motifs, for
+    :func:`rough.metrology.announce_undefined`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import rough
+    >>> from rough.metrology.segmentation import segment, undefined_reasons
+    >>> u = 2 * np.pi * (np.arange(36) - 4) / 9
+    >>> egg_box = rough.Surface(1e-6 * (np.cos(u)[None, :] + np.cos(u)[:, None]), 1e-6)
+    >>> undefined_reasons(segment(egg_box, "hills"), segment(egg_box, "dales"))
+    {'S5p': 'ISO 25178-2 averages the five highest peaks; 4 significant hills are counted'}
+    """
+    _check_edges(edges)
+    reasons = {}
+    for key, motifs, what, kind in (("S5p", hills, "highest peaks", "hills"), ("S5v", dales, "deepest pits", "dales")):
+        count = len(_counted(motifs, edges))
+        if count < FIVE:
+            reasons[key] = f"ISO 25178-2 averages the five {what}; {count} significant {kind} are counted"
+    return reasons
+
+
+def _five_point(heights):
+    """The mean of the five largest ``heights``; NaN when there are fewer than five."""
+    return float(np.mean(sorted(heights, reverse=True)[:FIVE])) if len(heights) >= FIVE else math.nan
 
 
 def _mean(values):

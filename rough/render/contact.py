@@ -259,14 +259,12 @@ def zero_order_hold(stiffness, damping, mass, period):
     spring = stiffness / mass * period / omega
     step = _exponential([[0.0, turn, 0.0], [-spring, -damping / mass * period, turn], [0.0] * 3])
     to_state = (1.0, omega, mass * omega * omega)  # x, v, F from the balanced state
-    return (
-        step[0][0],
-        step[0][1] / to_state[1],
-        step[1][0] * to_state[1],
-        step[1][1],
-        step[0][2] / to_state[2],
-        step[1][2] * to_state[1] / to_state[2],
-    )
+    p12 = step[0][1] / to_state[1]
+    # Φ21 = -(k/m) Φ12 and Γ2 = Φ12/m hold exactly (Φ12' = Φ22, Φ22' = -(k/m) Φ12 - (b/m) Φ22,
+    # and Γ2 = ∫Φ22/m): taken from Φ12, they keep its accuracy where the squarings lose
+    # that of a small entry (Γ2 of a stiff, heavily damped hold, 1e-11 of its column)
+    spring_step = 0.0 - stiffness / mass * p12  # +0.0 for a free mass
+    return (step[0][0], p12, spring_step, step[1][1], step[0][2] / to_state[2], p12 / mass)
 
 
 def _exponential(matrix):

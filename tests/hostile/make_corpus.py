@@ -986,6 +986,65 @@ def vendor_cases():
     )
 
 
+# -- issue 31: damaged files never pass as data ------------------------------------------------------
+
+
+def damage_cases():
+    from rough import Surface
+
+    rng = np.random.default_rng(31)
+    profile = _rough_file(Surface(rng.normal(size=200) * 1e-6, (1e-6,)), "tsv")
+    case("text-tsv-cut-mid-number.txt", profile[: profile.rindex(b"e-")], "cut short", "rough's TSV cut in -4.67e-07")
+    grid = _rough_file(Surface(rng.normal(size=(6, 8)) * 1e-6, (1e-6, 1e-6)), "tsv")
+    rows = grid.split(b"\n\n")
+    case("text-tsv-cut-at-a-row.txt", b"\n\n".join(rows[:3]) + b"\n\n", "cut short", "rough's TSV map, 3 rows of 6")
+    heights = rng.normal(size=(8, 12)) * 1e-9
+    export = "# Channel: Height\n# Width: 12.000 um\n# Height: 8.000 um\n# Value units: m\n" + "".join(
+        "\t".join(f"{value:g}" for value in row) + "\n" for row in heights
+    )
+    case("text-gwyddion-cut-at-200.txt", export.encode()[:200], "cut short", "Gwyddion's text export cut at 200 bytes")
+    case("text-short-last-row.txt", b"1 2 3 4\n5 6 7 8\n9 10\n", "line 3", "a matrix whose last row is short")
+    case("text-short-last-row-no-end.txt", b"1 2 3 4\n5 6 7 8\n9 10", "cut short", "the same, no line end")
+    huge = np.array([[1e-6, 2e-6, 1e308], [-1e308, 5e-6, 6e-6]])
+    case("x3p-1e308.x3p", _rough_file(Surface(huge, (1e-6, 1e-6)), "x3p"), "beyond", "float64 heights of ±1e308")
+    case("x3p-offset-1e308.x3p", x3p_file(np.array([[1, 2], [3, 4]]), code="I", offset=1e308), "beyond", "Offset 1e308")
+    case("gwy-1e308.gwy", _rough_file(Surface(huge, (1e-6, 1e-6)), "gwy"), "beyond", "GWY heights of ±1e308")
+    header = ["XRes = 16", "YRes = 16", "XReal = 1.6e-5", "YReal = 1.6e-5", "ZUnits = m"]
+    case("gsf-3e38.gsf", gsf(header, np.resize([1e-6, 3e38, -3e38], 256)), "beyond", "float32 heights of ±3e38")
+    measured = gsf(header, rng.normal(size=256) * 1e-6)
+    start = len(measured) - 256 * 4
+    noise = rng.integers(0, 256, 256 * 4, dtype=np.uint8).tobytes()
+    case("gsf-random-data.gsf", measured[:start] + noise, "beyond", "random bytes in place of the heights")
+    case("gsf-shifted-data.gsf", measured[:start] + b"\0\0\0" + measured[start:-3], "beyond", "heights 3 bytes late")
+    big = _bigtiff()
+    case("geotiff-bigtiff-cut.tif", big[: len(big) - 40], "GeoTIFF", "a BigTIFF cut short")
+    case(
+        "geotiff-bigtiff-ifd-far.tif",
+        big[:8] + struct.pack("<Q", 1 << 44) + big[16:],
+        "directory",
+        "a BigTIFF whose first directory lies 16 TiB on (libtiff printed a line of its own)",
+    )
+    no_crs = _geotiff(None, (2.0, 0, 0, 0, -2.0, 0), width=64, height=64)
+    case(
+        "geotiff-no-crs-cut.tif",
+        no_crs[:-1000],
+        "IReadBlock",
+        "a GeoTIFF with no CRS cut in its pixels (the warning about the CRS came before the refusal)",
+    )
+
+
+def _bigtiff():
+    """A small georeferenced BigTIFF (rasterio), its tags after its pixels."""
+    import rasterio
+    from rasterio.transform import from_origin
+
+    profile = {"driver": "GTiff", "width": 32, "height": 32, "count": 1, "dtype": "float32", "BIGTIFF": "YES"}
+    with rasterio.MemoryFile() as memory:
+        with memory.open(**profile, crs="EPSG:32632", transform=from_origin(500000, 5000000, 1, 1)) as dataset:
+            dataset.write(np.arange(32 * 32, dtype="float32").reshape(32, 32), 1)
+        return memory.read()
+
+
 def main():
     x3p_cases()
     exr_cases()
@@ -997,6 +1056,7 @@ def main():
     other_cases()
     hardening_cases()
     vendor_cases()
+    damage_cases()
     for old in HERE.iterdir():
         if old.suffix not in (".py", ".tsv") and old.is_file():
             old.unlink()
