@@ -657,19 +657,26 @@ def autocorrelation(surface, acf="iso"):
     hy, hx = ny // 2, nx // 2
     mean, count, constant = centring(z)
     products = _half_correlation(lambda rows: _deviation(z[rows], mean, constant), z.shape)
-    if acf == "iso":
-        pairs = np.ones_like(products)
-    elif count == z.size:
-        pairs = np.outer(ny - np.arange(hy + 1.0), nx - np.abs(np.arange(-hx, hx + 1.0)))
-    else:
-        pairs = np.rint(_half_correlation(lambda rows: (~np.isnan(z[rows])).astype(np.float64), z.shape))
     result = np.empty((2 * hy + 1, 2 * hx + 1))
     with np.errstate(invalid="ignore", divide="ignore"):
-        np.divide(products, pairs, out=result[hy:])
-        result[hy:][pairs == 0] = np.nan  # no pair of valid points at this lag (not the rounding of the FFTs)
+        if acf == "iso":
+            result[hy:] = products
+        else:
+            np.divide(products, _pair_counts(z, count), out=result[hy:])
         result[hy:] /= result[hy, hx]
     result[:hy] = result[:hy:-1, ::-1]  # the autocorrelation of a real field: acf(-l) = acf(l)
     return result, np.arange(-hx, hx + 1) * surface.spacing[0], np.arange(-hy, hy + 1) * surface.spacing[1]
+
+
+def _pair_counts(z, count):
+    """The number of pairs of valid points at each lag of :func:`autocorrelation`'s
+    half plane (``count`` valid points in all); NaN where there is none."""
+    ny, nx = z.shape
+    if count == z.size:
+        return np.outer(ny - np.arange(ny // 2 + 1.0), nx - np.abs(np.arange(-(nx // 2), nx // 2 + 1.0)))
+    pairs = np.rint(_half_correlation(lambda rows: (~np.isnan(z[rows])).astype(np.float64), z.shape))
+    pairs[pairs == 0] = np.nan  # no pair of valid points at this lag (not the rounding of the FFTs)
+    return pairs
 
 
 def _deviation(heights, mean, constant):
