@@ -72,6 +72,17 @@ def shuffled(draw, values):
     return np.insert(values[list(order)], holes, np.nan)
 
 
+@st.composite
+def map_and_shuffled(draw, values, rows):
+    """A map of ``rows`` rows from ``values`` (cycled to fill them), and its heights in
+    another order with ``rows`` NaN holes put anywhere, one column wider."""
+    columns = max(2, values.size // rows)
+    values = np.resize(values, rows * columns)
+    order = list(draw(st.permutations(range(values.size))))
+    holes = draw(st.lists(st.integers(0, values.size), min_size=rows, max_size=rows))
+    return values.reshape(rows, columns), np.insert(values[order], holes, np.nan).reshape(rows, columns + 1)
+
+
 def same(a, b):
     """Equal, counting NaN as equal to NaN."""
     return a == b or (math.isnan(a) and math.isnan(b))
@@ -105,12 +116,8 @@ def test_profile_material_ratio_family_is_order_free(data, values):
 @EXAMPLES
 @given(st.data(), heights(min_size=4, max_size=150), st.integers(2, 6))
 def test_areal_material_ratio_family_is_order_free(data, values, rows):
-    columns = max(2, values.size // rows)
-    values = np.resize(values, rows * columns)
-    order = list(data.draw(st.permutations(range(values.size))))
-    holes = data.draw(st.lists(st.integers(0, values.size), min_size=rows, max_size=rows))
-    other = np.insert(values[order], holes, np.nan).reshape(rows, columns + 1)  # `rows` holes anywhere
-    base = functional_parameters(Surface(values.reshape(rows, columns), (1e-6, 1e-6)))
+    values, other = data.draw(map_and_shuffled(values, rows))
+    base = functional_parameters(Surface(values, (1e-6, 1e-6)))
     moved = functional_parameters(Surface(other, (1e-6, 1e-6)))
     for key in AREAL_FUNCTIONAL:
         assert same(moved[key], base[key]), (key, base[key], moved[key])
@@ -237,12 +244,8 @@ def test_primary_profile_height_distribution_is_order_free(data, values):
 @EXAMPLES
 @given(st.data(), heights(min_size=4, max_size=64), st.integers(2, 4))
 def test_areal_height_distribution_is_order_free(data, values, rows):
-    columns = max(2, values.size // rows)
-    values = np.resize(values, rows * columns)
-    order = list(data.draw(st.permutations(range(values.size))))
-    holes = data.draw(st.lists(st.integers(0, values.size), min_size=rows, max_size=rows))
-    other = np.insert(values[order], holes, np.nan).reshape(rows, columns + 1)  # `rows` holes anywhere
-    base = quiet(areal_parameters, Surface(values.reshape(rows, columns), (1e-6, 1e-6)))
+    values, other = data.draw(map_and_shuffled(values, rows))
+    base = quiet(areal_parameters, Surface(values, (1e-6, 1e-6)))
     moved = quiet(areal_parameters, Surface(other, (1e-6, 1e-6)))
     assert_distribution_close(base, moved, AREAL_DISTRIBUTION, moment_tolerances(values))
 
