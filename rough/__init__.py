@@ -20,8 +20,17 @@ is cheap and the command line starts quickly. ``rough.metrology``, ``rough.fract
 """
 
 import importlib
+import os
+import sys
 
-__version__ = "0.10.0"
+# OpenBLAS's worker threads cost more than they give in the small solves and optimisers of
+# the fits: on a busy 2-core machine an L-BFGS-B fit took 20 times longer with them
+# (docs/design.rst, "Threads"). Only before numpy loads OpenBLAS, and never over a choice
+# already made in the environment.
+if "numpy" not in sys.modules:
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+__version__ = "0.11.0"
 
 # public name -> module that defines it (imported on first use)
 _LAZY = {

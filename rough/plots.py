@@ -705,6 +705,51 @@ def rose_figure(rose, title="direction dependence"):
 
 
 @_styled
+def scale_dependent_figure(table, title="roughness against scale", cutoff=None):
+    """RMS height, slope and curvature against scale on log-log axes, three panels
+    side by side (``table`` as :func:`rough.fractal.scales.scale_dependent` gives it;
+    scales and heights in the unit that reads naturally, curvature in 1/that unit).
+    A reliability cut-off (m) is drawn where the tip stops following the surface.
+    ``title``: e.g. the file name.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from rough.fractal.scales import scale_dependent
+    >>> from rough.plots import scale_dependent_figure
+    >>> heights = np.cumsum(np.random.default_rng(0).standard_normal(1024)) * 1e-8
+    >>> figure = scale_dependent_figure(scale_dependent(heights, 1e-6), "random walk")
+    >>> [axes.get_ylabel() for axes in figure.axes]
+    ['RMS height (nm)', 'RMS slope', 'RMS curvature (1/µm)']
+    >>> import matplotlib.pyplot as plt
+    >>> plt.close(figure)
+    """
+    plt = _pyplot()
+    scale = np.asarray(table["scale"], float)
+    per_scale, scale_symbol = length_unit(float(np.max(scale)) if scale.size else 0.0)
+    heights = np.asarray(table["rms_height"], float)
+    per_height, height_symbol = length_unit(float(np.max(heights)) if heights.size else 0.0)
+    figure, axes = plt.subplots(1, 3, figsize=(12, 4.2))
+    direction = table.get("direction")
+    panels = (
+        (heights * per_height, f"RMS height ({height_symbol})", "tab:red"),
+        (np.asarray(table["rms_slope"], float), "RMS slope", "tab:green"),
+        (np.asarray(table["rms_curvature"], float) / per_scale, f"RMS curvature (1/{scale_symbol})", "tab:blue"),
+    )
+    for axis, (values, label, colour) in zip(axes, panels):
+        shown = values > 0
+        axis.loglog(scale[shown] * per_scale, values[shown], "o-", ms=3.5, lw=1.2, color=colour)
+        if cutoff:
+            axis.axvline(cutoff / 2 * per_scale, color="0.3", lw=0.8, ls="--", label="tip reliability cut-off")
+            axis.legend(fontsize=7)
+        axis.set_xlabel(f"scale λ ({scale_symbol})")
+        axis.set_ylabel(label)
+    along = {"x": " (profiles along x)", "y": " (profiles along y)"}.get(direction, "")
+    figure.suptitle(f"{title}{along}")
+    return figure
+
+
+@_styled
 def force_figure(runs, title=None):
     """Force profiles of render runs ``[(label, Run), ...]``: for each, the surface
     height under the stylus and the hand's height (top), and F_y and F_x against the

@@ -6,8 +6,12 @@ import pathlib
 import subprocess
 import sys
 
-import pytest
-from hypothesis import settings
+# what `import rough` sets when numpy is not loaded yet (docs/design.rst, "Threads"); test
+# modules import numpy first
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import pytest  # noqa: E402
+from hypothesis import settings  # noqa: E402
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 

@@ -58,6 +58,7 @@ EXPECTED_FORMAT = {
     "SurfaceTopography/x3p-2.x3p": "x3p",
     "surfalize/test_1.zon": "zon",
     "dem/TM1_564_146.tif": "geotiff",
+    "dem/coronaA_grids.npz": "npz",
     "dem/faultzone.tif": "geotiff",
     "opengps/KautschukInfiniteFocus.x3p": "x3p",
 }

@@ -127,13 +127,13 @@ def test_fit_outputs_spectrum_and_plot(tmp_path):
     assert (tmp_path / "psd.png").read_bytes()[:4] == b"\x89PNG"
 
 
-def test_band_and_methods():
+def test_band_estimator_and_sampling():
     surface = rough(
         "synth", "--length", "40mm", "--dimension", "1.3", "--rq", "0.2mm", "--seed", "5", check=True
     ).stdout
     banded = fit_json("--band", "0.1/mm:5/mm", input=surface)
     assert banded["band"][0] >= 100 and banded["band"][1] <= 5000
-    assert fit_json("--method", "variogram", input=surface)["method"] == "variogram"
+    assert fit_json("--estimator", "variogram", "--replicates", "4", input=surface)["estimator"] == "variogram"
     assert fit_json("--sampling", "point", input=surface)["sampling"] == "point"
 
 

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from rough import Surface
-from rough.fractal.fit import FractalFit, _announce
+from rough.fractal.fit import FractalFit, announce
 from rough.metrology import parameters
 
 from conftest import assert_one_line_error
@@ -41,7 +41,7 @@ def test_an_undefined_fit_result_is_named(caplog):
     fit = FractalFit(1.5, 0.01, float("nan"), float("nan"), 1e-6, float("inf"), 0.5, (0.0, 1.0), "whittle", "none",
                      "point", 10, float("nan"))  # fmt: skip
     with caplog.at_level(logging.WARNING, logger="rough"):
-        _announce(fit)
+        announce(fit)
     assert "amplitude_coefficient" in caplog.text and "psd_prefactor" in caplog.text
 
 

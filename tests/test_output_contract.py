@@ -20,7 +20,7 @@ NUMERIC_UNITS = {"m", "1/m", "1", "N", "s", "Hz", "deg", "points", "m^(3-β)", "
 # text rows labelled for people (tables), each documented in docs/output.rst
 LABELLED = re.compile(
     r"^(θ =.*|\S+mm_s\.\S+|variable|answers|likelihood ratio|log-likelihood|fractal dimension D|Rq \(per mm\)"
-    r"|constant|subject \S+|.*\(L=.*\)|scaling)$"
+    r"|constant|subject \S+|.*\(L=.*\)|scaling|estimator \S+|λ = .*)$"
 )
 
 
@@ -51,9 +51,11 @@ COMMANDS = {
     "features profile": ("features", "--vs-length", PROFILE),
     "features map": ("features", MAP),
     "fit-fractal profile": ("fit-fractal", PROFILE),
-    "fit-fractal loglog": ("fit-fractal", "--method", "loglog", PROFILE),
+    "fit-fractal dfa": ("fit-fractal", "--estimator", "dfa", "--replicates", "4", PROFILE),
     "fit-fractal map": ("fit-fractal", "--fill", MAP),
+    "fit-fractal profiles": ("fit-fractal", "--profiles", "30", MAP),
     "rose": ("rose", "--fill", "--step", "30", MAP),
+    "rose profiles": ("rose", "--fill", "--step", "30", "--profiles", MAP),
     "render": ("render", "--speed", "20mm/s", PROFILE),
     "render two speeds": ("render", "--speed", "20mm/s", "--speed", "60mm/s", PROFILE),
     "formats": ("formats",),

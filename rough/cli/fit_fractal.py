@@ -2,8 +2,23 @@
 
 import click
 
-from .options import BAND, LENGTH, crop_option, model_options, plot_option, report_format, surface_input
+from ..errors import InputError
+from .options import (
+    BAND,
+    DIRECTION,
+    LENGTH,
+    crop_option,
+    gaps_option,
+    model_options,
+    plot_option,
+    report_format,
+    surface_input,
+)
 from .report import Report, on_stdout, shown
+
+#: The names of rough.fractal.estimators.ESTIMATORS, kept here so that --help does not load
+#: numpy (tests/test_hurst_cli.py checks the two agree).
+ESTIMATOR_NAMES = ("whittle", "variogram", "dfa", "wavelet", "higuchi")
 
 
 @click.command("fit-fractal", short_help="Fractal dimension D and amplitude coefficient C, with uncertainty.")
@@ -16,12 +31,25 @@ from .report import Report, on_stdout, shown
 )
 @click.option("--resolution", type=LENGTH, help="The resolution η at which C is stated (default: the spacing).")
 @click.option(
-    "--method",
-    type=click.Choice(["whittle", "variogram", "madogram", "loglog"]),
-    default="whittle",
-    show_default=True,
-    help="Whittle likelihood of the spectrum (the estimator), or a cross-check (profiles only).",
+    "--profiles",
+    "direction",
+    type=DIRECTION,
+    help="Fit the map's profiles along x, y or an angle (degrees from +x) instead of its 2-D spectrum: "
+    "H, D = 2 - H and C of the profiles, as the fault literature measures them.",
 )
+@gaps_option
+@click.option(
+    "--estimator",
+    type=click.Choice([*ESTIMATOR_NAMES, "all"]),
+    help="H by this estimator of profiles (or all side by side), calibrated on exact fBm of the data's "
+    "size, sampling, gaps and noise: bias-corrected H with a 95 % interval, and the raw value.",
+)
+@click.option(
+    "--replicates",
+    type=click.IntRange(2, 10000),
+    help="With --estimator: synthetic replicates per calibration point (default: as the data's size allows).",
+)
+@click.option("--seed", type=click.IntRange(0), default=0, show_default=True, help="Seed of the calibration's data.")
 @click.option(
     "--order",
     type=click.IntRange(0, 10),
@@ -51,13 +79,18 @@ def fit_fractal(
     input,
     band,
     resolution,
-    method,
+    direction,
+    gaps,
+    estimator,
+    replicates,
+    seed,
     order,
     sampling,
     fill,
     noise,
     rolloff,
     level,
+    tip_radius,
     psd_file,
     plot,
 ):
@@ -71,69 +104,125 @@ def fit_fractal(
     surfaces plus a white noise floor (and, with --rolloff, a short-wavelength
     roll-off); maps are fitted on the ring-averaged, Hann-windowed 2-D periodogram.
     Without --band the band is the scaling range: the widest band of at least a
-    decade over which the model passes a χ² goodness-of-fit test of the
-    periodogram at --level. Where none does, the verdict is "no power-law range"
-    and no D is printed; a D on the edge of the range is a bound, printed without
-    "±". Every result names its band, test p-value, noise floor, sampling model
-    and method.
+    decade over which the spectrum's local exponent stays within 0.1 in H of the
+    band's (the χ² test's p-value is reported as a diagnostic). Where no band
+    qualifies, the verdict is "no power-law range" and the RMS height, slope and
+    curvature against scale are printed instead; a D on the edge of the range is a
+    bound, printed without "±". Every result names its band, noise floor, sampling
+    model and method.
+
+    --profiles fits the profiles of a map along a direction instead (H, D = 2 - H
+    and C of the profiles, as the fault literature measures them), with errors from
+    a jackknife over blocks of neighbouring profiles. --estimator measures H by
+    another estimator (or all five side by side), calibrated on exact fBm of the
+    data's own size, sampling and noise: the bias-corrected H with a 95 % interval,
+    and the raw value.
 
     \b
     Examples:
         rough fit-fractal rock.x3p
         rough synth --length 80mm --dimension 1.3 --rq 0.3mm | rough fit-fractal --json
+        rough fit-fractal --profiles x --estimator all fault.npz
         rough fit-fractal --band 0.05/mm:5/mm --resolution 0.0309mm --psd psd.tsv --plot psd.png scan.x3p
     """
-    from ..fractal.fit import fit_fractal as fit
-    from ..fractal.psd import binned_spectrum
     from ..fractal.resample import fill_invalid
-    from ..io.atomic import atomic_output
 
     report = not on_stdout(psd=psd_file, plot=plot)
     if fill:
         surface = fill_invalid(surface)
-    result = fit(
-        surface,
-        band=band,
-        resolution=resolution,
-        method=method,
-        order=order,
-        sampling=sampling,
-        noise=noise,
-        rolloff=rolloff,
-        level=level,
-    )
+    model = {"band": band, "resolution": resolution, "sampling": sampling, "noise": noise, "rolloff": rolloff}
+    model.update(level=level, order=order, tip_radius=tip_radius)
+    if estimator or direction is not None:
+        if estimator and (psd_file or plot):
+            raise InputError("--psd and --plot draw a spectrum and its fit: leave out --estimator")
+        if estimator:
+            return _estimators_report(surface, direction, gaps, estimator, replicates, seed, model)
+        return _profiles_report(surface, input, direction, gaps, model, psd_file, plot, report)
+    from ..fractal.fit import fit_fractal as fit
+    from ..fractal.psd import binned_spectrum
+
+    result = fit(surface, **model)
     spectrum = binned_spectrum(surface, order) if (psd_file or plot or surface.is_profile) else None
     document = {**result.as_dict(), "points": surface.heights.size}
     if spectrum and "parseval" in spectrum:
         document["parseval"] = spectrum["parseval"]
     if psd_file:
-        unit = "m3" if surface.is_profile else "m4"
-        lines = [
-            f"# rough fit-fractal: log-binned spectrum "
-            f"({'Hann periodogram G' if surface.is_profile else 'ring-averaged P2'})",
-            f"frequency_per_m\tdensity_{unit}\tcount",
-        ]
-        lines += [
-            f"{f!r}\t{g!r}\t{n}" for f, g, n in zip(spectrum["frequency"], spectrum["density"], spectrum["count"])
-        ]
-        with atomic_output(psd_file) as stream:
-            stream.write(("\n".join(lines) + "\n").encode())
-    if plot:
-        import numpy as np
-
+        what, unit = ("Hann periodogram G", "m3") if surface.is_profile else ("ring-averaged P2", "m4")
+        _write_psd(psd_file, spectrum, what, unit)
+    if plot and result.scale_dependent:
         from .. import plots
 
-        plots.save(
-            plots.spectrum_figure(
-                np.array(spectrum["frequency"]),
-                np.array(spectrum["density"]),
-                result,
-                surface.spacing,
-                _title(input, surface),
-            ),
-            plot,
-        )
-    return Report(_rows(result, surface, document), document) if report else None
+        title = f"{_title(input, surface)}: no power-law band"
+        plots.save(plots.scale_dependent_figure(result.scale_dependent, title, result.reliability_cutoff), plot)
+    elif plot:
+        _plot_spectrum(plot, spectrum, result, surface.spacing, _title(input, surface))
+    return Report(_rows(result, surface.is_profile, document), document) if report else None
+
+
+def _profiles_report(surface, input, direction, gaps, model, psd_file, plot, report):
+    """The pooled Whittle fit of the profiles along ``direction``; ``--psd`` writes and
+    ``--plot`` draws their mean spectrum with the per-profile spread."""
+    from ..fractal.profiles import fit_profiles, take_profiles
+    from ..fractal.psd import profile_spectrum
+
+    result = fit_profiles(surface, direction, gaps, **model)
+    document = result.as_dict()
+    if psd_file or plot:
+        profiles = take_profiles(surface, direction, gaps, model["order"])
+        spectrum = profile_spectrum(profiles.heights, profiles.spacing)
+        if psd_file:
+            _write_psd(
+                psd_file,
+                spectrum,
+                f"mean Hann periodogram G of {result.profiles} profiles along {result.direction}",
+                extra=("profiles", "log10_spread"),
+            )
+        if plot:
+            _plot_spectrum(
+                plot,
+                spectrum,
+                result.fit,
+                (profiles.spacing,),
+                f"{_title(input, surface)}, profiles along {result.direction}",
+            )
+    return Report(_rows(result.fit, True, document) + _profile_rows(result), document) if report else None
+
+
+def _estimators_report(surface, direction, gaps, estimator, replicates, seed, model):
+    """The calibrated H of the profiles along ``direction`` by one estimator or all."""
+    if direction is None and not surface.is_profile:
+        raise InputError("--estimator measures H of profiles: give --profiles x, y or an angle for a map")
+    from ..fractal.hurst import hurst_exponents
+
+    direction = "x" if direction is None else direction
+    names = None if estimator == "all" else [estimator]
+    table = hurst_exponents(surface, direction, names, gaps, replicates=replicates, seed=seed, **model)
+    document = table.as_dict()
+    replaced = {"fractal_dimension", "fractal_dimension_stderr", "hurst"}
+    whittle = [row for row in _rows(table.profile_fit.fit, True, document) if row[0] not in replaced]
+    return Report(_estimator_rows(table, document) + whittle + _profile_rows(table.profile_fit), document)
+
+
+def _write_psd(path, spectrum, what, unit="m3", extra=()):
+    """The log-binned spectrum as TSV: frequency (1/m), density (``unit``), count, and
+    ``extra`` columns."""
+    from ..io.atomic import atomic_output
+
+    columns = ["frequency_per_m", f"density_{unit}", "count", *extra]
+    keys = ["frequency", "density", "count", *("log_spread" if name == "log10_spread" else name for name in extra)]
+    lines = [f"# rough fit-fractal: log-binned spectrum ({what})", "\t".join(columns)]
+    lines += ["\t".join(repr(value) for value in row) for row in zip(*(spectrum[key] for key in keys))]
+    with atomic_output(path) as stream:
+        stream.write(("\n".join(lines) + "\n").encode())
+
+
+def _plot_spectrum(plot, spectrum, fit, spacing, title):
+    import numpy as np
+
+    from .. import plots
+
+    figure = plots.spectrum_figure(np.array(spectrum["frequency"]), np.array(spectrum["density"]), fit, spacing, title)
+    plots.save(figure, plot)
 
 
 def _title(input, surface):
@@ -142,15 +231,21 @@ def _title(input, surface):
     return f"{shown(input)}: {title}" if title else shown(input)
 
 
-def _rows(result, surface, document):
+def _rows(result, is_profile, document):
     from ..units import format_length
 
-    key = "D" if surface.is_profile else "Ds"
+    key = "D" if is_profile else "Ds"
     if result.verdict == "no power-law range":
         return [
             ("verdict", result.verdict, "", f"no power-law range: {result.hint}"),
-            ("fractal_dimension", None, "1", "none: no band over which the spectrum is a power law"),
-            ("p_value", result.p_value, "1", f"{result.p_value:.3g} (the best of any band of a decade)"),
+            (
+                "fractal_dimension",
+                None,
+                "1",
+                "none: no band of a decade keeps its local exponent; roughness against scale instead:",
+            ),
+            *_scale_rows(result.scale_dependent),
+            *_cutoff_rows(result),
             _method_row(result),
         ]
     rows = [
@@ -196,7 +291,7 @@ def _rows(result, surface, document):
         (
             "psd_prefactor",
             result.psd_prefactor,
-            "m^(3-β)" if surface.is_profile else "m^(4-α)",
+            "m^(3-β)" if is_profile else "m^(4-α)",
             f"{result.psd_prefactor:.5g} (the spectrum at f = 1/m, SI units)",
         ),
         ("hurst", result.hurst, "1", f"H = {result.hurst:.4f}"),
@@ -221,12 +316,45 @@ def _rows(result, surface, document):
         rows.append(
             ("rolloff_wavelength", result.rolloff_wavelength, "m", f"{format_length(result.rolloff_wavelength)} (1/fc)")
         )
+    rows += _cutoff_rows(result)
     rows.append(_method_row(result))
     if "parseval" in document:
         rows.append(
             ("parseval", document["parseval"], "1", f"{document['parseval']:.12f} (Σ G Δf over the windowed variance)")
         )
     return rows
+
+
+SCALE_UNITS = {"scale": "m", "rms_height": "m", "rms_slope": "1", "rms_curvature": "1/m", "direction": ""}
+
+
+def _scale_rows(table):
+    """The scale-dependent roughness: one row holding the table, then a line per scale."""
+    from ..units import format_length, format_quantity
+
+    rows = [
+        (
+            "scale_dependent",
+            table,
+            SCALE_UNITS,
+            f"{len(table['scale'])} scales along {table['direction']}: scale, RMS height, RMS slope, RMS curvature",
+        )
+    ]
+    for scale, height, slope, curvature in zip(
+        table["scale"], table["rms_height"], table["rms_slope"], table["rms_curvature"]
+    ):
+        text = f"{format_length(height):>12}  {slope:10.4g}  {format_quantity(curvature, '1/m'):>14}"
+        rows.append((None, None, None, text, f"λ = {format_length(scale)}"))
+    return rows
+
+
+def _cutoff_rows(result):
+    from ..units import format_length
+
+    if result.reliability_cutoff is None:
+        return []
+    text = f"{format_length(result.reliability_cutoff)}: shorter wavelengths left out (the tip cannot follow)"
+    return [("reliability_cutoff", result.reliability_cutoff, "m", text)]
 
 
 def _dimension_text(result, key):
@@ -265,3 +393,131 @@ def _method_row(result):
         "",
         f"{result.method}; window {result.window}; sampling {result.sampling} ({result.sampling_source})",
     )
+
+
+def _profile_rows(result):
+    """What a profiles fit adds: the direction, how the profiles were taken, the spread."""
+    spread = result.hurst_spread
+    rows = [
+        ("kind", result.kind, "", "H of 1-D profiles along a direction (not the map's 2-D spectrum)"),
+        (
+            "direction",
+            result.direction,
+            "",
+            "the profile itself" if result.direction == "profile" else f"profiles along {result.direction}",
+        ),
+        ("angle", None if result.angle != result.angle else result.angle, "deg", _angle_text(result.angle)),
+        (
+            "profiles",
+            result.profiles,
+            "1",
+            f"{result.profiles} profiles, {result.points} points; gaps: {result.gaps}; heights: {result.interpolation}",
+        ),
+        (
+            "hurst_stderr",
+            result.hurst_stderr,
+            "1",
+            "none: a bound has no standard error"
+            if result.hurst_stderr is None
+            else f"{result.hurst_stderr:.4f} (standard error of H: {result.stderr_method})",
+        ),
+        (
+            "hurst_spread",
+            spread,
+            "1",
+            "not measured (fewer than two profiles in the band)"
+            if spread != spread
+            else f"{spread:.4f} (SD of the profiles' own H over the band)",
+        ),
+        (
+            "design_effect",
+            result.design_effect,
+            "1",
+            f"{result.design_effect:.3g} (neighbouring profiles' correlation: the likelihood's weights divided by it)",
+        ),
+    ]
+    return rows
+
+
+def _angle_text(angle):
+    return "none (a profile)" if angle != angle else f"{angle:.1f}° counter-clockwise from +x"
+
+
+def _estimator_rows(table, document):
+    """One row per estimator: the calibrated H, its 95 % interval, the raw value, the bias."""
+    from ..units import format_length
+
+    rows = [(None, None, None, "H (calibrated)  95 % interval   raw H    bias", "estimators")]
+    for index, (estimate, record) in enumerate(zip(table.estimates, document["estimators"])):
+        low, high = estimate.interval
+        bound = f" (at the {estimate.at_bound} bound)" if estimate.at_bound else ""
+        if estimate.hurst != estimate.hurst:
+            rows.append(
+                (f"estimators.{index}", record, ESTIMATE_UNITS, estimate.method, f"estimator {estimate.estimator}")
+            )
+            continue
+        rows.append(
+            (
+                f"estimators.{index}",
+                record,
+                ESTIMATE_UNITS,
+                f"{estimate.hurst:14.3f}  {low:6.3f} to {high:5.3f}  {estimate.raw:6.3f}  {estimate.bias:+6.3f}{bound}",
+                f"estimator {estimate.estimator}",
+            )
+        )
+    scales = table.scales
+    whittle = (
+        "the Whittle fit found no power-law band"
+        if scales is None
+        else f"the Whittle fit's band: wavelengths {format_length(scales[0])} to {format_length(scales[1])}"
+    )
+    rows.append(
+        (
+            "scales",
+            None if scales is None else list(scales),
+            "m",
+            f"{whittle}; the others over their own ranges from its short end (estimators.N.scales) unless "
+            f"--band or --tip-radius sets the band; calibrated on exact fBm (replicates per point: "
+            f"estimators.N.replicates)",
+        )
+    )
+    first = table.first
+    stderr = document["fractal_dimension_stderr"]
+    rows += [
+        (
+            "hurst",
+            document["hurst"],
+            "1",
+            f"H = {first.hurst:.4f} ({first.estimator}, calibrated; 95 %: {first.interval[0]:.3f} to "
+            f"{first.interval[1]:.3f})",
+        ),
+        ("fractal_dimension", document["fractal_dimension"], "1", f"D = 2 - H = {2 - first.hurst:.4f}"),
+        (
+            "fractal_dimension_stderr",
+            stderr,
+            "1",
+            "none: a bound has no standard error"
+            if stderr is None
+            else f"{stderr:.4f} (the interval's half-width / 1.96)",
+        ),
+        (
+            "whittle_fit_hurst",
+            document["whittle_fit_hurst"],
+            "1",
+            f"{document['whittle_fit_hurst']:.4f} (H of the pooled Whittle fit, uncalibrated)",
+        ),
+    ]
+    return rows
+
+
+ESTIMATE_UNITS = {
+    "estimator": "",
+    "raw": "1",
+    "hurst": "1",
+    "interval": "1",
+    "bias": "1",
+    "replicates": "1",
+    "method": "",
+    "scales": "m",
+    "at_bound": "",
+}

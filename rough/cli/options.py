@@ -185,6 +185,29 @@ class TipType(PositiveLengthType):
         return super().convert(value, param, ctx)
 
 
+class DirectionType(click.ParamType):
+    """A direction in the map's plane: ``x`` (along the rows), ``y`` (along the columns),
+    or an angle counter-clockwise from +x in degrees (``30``, ``30deg``, ``-45°``) →
+    ``"x"``, ``"y"`` or radians in [0, π)."""
+
+    name = "x|y|ANGLE"
+
+    def convert(self, value, param, ctx):
+        if not isinstance(value, str):
+            return value
+        text = value.strip().lower()
+        if text in ("x", "y"):
+            return text
+        number = text.removesuffix("°").removesuffix("deg").strip()
+        try:
+            degrees = float(number)
+        except ValueError:
+            self.fail(f"{value!r}: give x, y or an angle in degrees (e.g. 30 or 30deg)", param, ctx)
+        if not math.isfinite(degrees) or abs(degrees) > 360:
+            self.fail(f"{value!r}: an angle must be finite and within ±360°", param, ctx)
+        return math.radians(degrees % 180)
+
+
 class CropType(click.ParamType):
     """``X0:X1`` or ``X0:X1,Y0:Y1`` (lengths; an empty end is open) → ((x0, x1), (y0, y1) or None)."""
 
@@ -276,6 +299,7 @@ LENGTH = PositiveLengthType()
 TIP = TipType()
 SPACING = SpacingType()
 CROP = CropType()
+DIRECTION = DirectionType()
 BAND = FrequencyRangeType()
 RATIO = RatioType()
 RATIOS = RatioPairType()
@@ -293,9 +317,20 @@ def crop_option(command):
     )(command)
 
 
+def gaps_option(command):
+    """``--gaps longest|fill``: how profiles taken from a map treat its invalid points."""
+    return click.option(
+        "--gaps",
+        type=click.Choice(["longest", "fill"]),
+        default="longest",
+        show_default=True,
+        help="With --profiles: keep each profile's longest run of valid points, or fill its gaps linearly.",
+    )(command)
+
+
 def model_options(command):
     """The spectral model's options, shared by ``fit-fractal`` and ``rose``: ``--no-noise``,
-    ``--rolloff`` and the goodness-of-fit test's ``--level``."""
+    ``--rolloff``, the goodness-of-fit diagnostic's ``--level`` and ``--tip-radius``."""
     for option in reversed(
         (
             click.option(
@@ -312,7 +347,13 @@ def model_options(command):
                 type=FloatRange(0, 1, min_open=True, max_open=True),
                 default=0.01,
                 show_default=True,
-                help="Goodness-of-fit level for the automatic band (the widest band whose p reaches it).",
+                help="Level of the χ² goodness-of-fit diagnostic (logged with -v); the band is chosen by effect "
+                "size: the widest band of a decade or more where the local exponent keeps within 0.1 in H.",
+            ),
+            click.option(
+                "--tip-radius",
+                type=TIP,
+                help="Leave out the scales a tip of this radius cannot follow (the curvature criterion).",
             ),
         )
     ):

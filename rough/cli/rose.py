@@ -2,7 +2,17 @@
 
 import click
 
-from .options import BAND, LENGTH, FloatRange, crop_option, model_options, plot_option, report_format, surface_input
+from .options import (
+    BAND,
+    LENGTH,
+    FloatRange,
+    crop_option,
+    gaps_option,
+    model_options,
+    plot_option,
+    report_format,
+    surface_input,
+)
 from .report import Report, on_stdout, shown
 
 
@@ -32,10 +42,34 @@ from .report import Report, on_stdout, shown
 )
 @click.option("--sampling", type=click.Choice(["point", "band-limited"]), help="As for fit-fractal.")
 @click.option("--fill", is_flag=True, help="Fill invalid points first (biharmonic inpainting).")
+@click.option(
+    "--profiles",
+    is_flag=True,
+    help="Also fit the map's profiles along each direction (H(θ), D(θ) = 2 - H, C(θ) by the pooled Whittle "
+    "fit of 1-D profiles, as the fault literature measures them), beside the 2-D sector rose.",
+)
+@gaps_option
 @model_options
 @plot_option("Draw polar roses of C(θ) and D(θ), mirrored to 360°; - is standard output, instead of the report.")
 @report_format
-def rose(surface, input, step, width, band, resolution, order, sampling, fill, noise, rolloff, level, plot):
+def rose(
+    surface,
+    input,
+    step,
+    width,
+    band,
+    resolution,
+    order,
+    sampling,
+    fill,
+    profiles,
+    gaps,
+    noise,
+    rolloff,
+    level,
+    tip_radius,
+    plot,
+):
     """Fit the surface dimension Ds(θ) and amplitude coefficient C(θ) of the map
     INPUT (default: standard input) in direction sectors of its Hann-windowed 2-D
     power spectrum, with the axis lines, where a map's edges leak, left out. θ is the
@@ -46,12 +80,15 @@ def rose(surface, input, step, width, band, resolution, order, sampling, fill, n
     across it, the lay at the long-wavelength end and at the resolution η (on a
     fault surface read the long-wavelength lay as the slip direction), χ² tests of
     isotropy over the sectors not at a bound, and ISO 25178-2 Str and Std. Unequal
-    x and y spacing is handled exactly (physical frequencies).
+    x and y spacing is handled exactly (physical frequencies). --profiles adds, beside
+    this 2-D sector rose, H(θ), D(θ) and C(θ) fitted on the map's 1-D profiles along
+    each direction (what the fault literature reports; see fit-fractal --profiles).
 
     \b
     Examples:
         rough rose scan.x3p
         rough rose --step 15 --plot rose.png --json fault.x3p
+        rough rose --step 15 --profiles fault.npz
         rough synth --size 1024x1024 --spacing 10um --anisotropy 2.2,1um,2.5,3um,30 | rough rose
     """
 
@@ -60,23 +97,25 @@ def rose(surface, input, step, width, band, resolution, order, sampling, fill, n
 
     if fill:
         surface = fill_invalid(surface)
-    result = directions(
-        surface,
-        step=step,
-        width=width,
-        band=band,
-        resolution=resolution,
-        order=order,
-        sampling=sampling,
-        noise=noise,
-        rolloff=rolloff,
-        level=level,
-    )
+    model = {"band": band, "resolution": resolution, "order": order, "sampling": sampling, "noise": noise}
+    model.update(rolloff=rolloff, level=level, tip_radius=tip_radius)
+    result = directions(surface, step=step, width=width, **model)
     if plot:
         from .. import plots
 
         plots.save(plots.rose_figure(result, shown(input)), plot)
-    return None if on_stdout(plot=plot) else Report(_rows(result), result.as_dict())
+    if on_stdout(plot=plot):
+        return None
+    document, rows = result.as_dict(), _rows(result)
+    if profiles:
+        import math
+
+        from ..fractal.profiles import profile_rose
+
+        along = profile_rose(surface, step=math.radians(step), gaps=gaps, **model)
+        document["profiles"] = along.as_dict()
+        rows += _profile_rows(along)
+    return Report(rows, document)
 
 
 def _sector_text(dimension, dimension_error, amplitude, amplitude_error):
@@ -193,4 +232,45 @@ def _rows(result):
             ),
         ),
     ]
+    return rows
+
+
+PROFILE_UNITS = {
+    "angle": "deg",
+    "hurst": "1",
+    "hurst_stderr": "1",
+    "fractal_dimension": "1",
+    "fractal_dimension_stderr": "1",
+    "amplitude_coefficient": "m",
+    "amplitude_coefficient_stderr": "m",
+    "band": "1/m",
+    "profiles": "1",
+    "verdict": "",
+}
+
+
+def _profile_rows(along):
+    """The profiles' H(θ), D(θ), C(θ): one row per direction, after a header naming them."""
+    from ..units import format_length
+
+    rows = [
+        (
+            None,
+            None,
+            None,
+            f"profiles along θ (1-D pooled Whittle fits, {along.interpolation} heights, gaps: {along.gaps}; "
+            f"errors: {along.stderr_method})",
+            "profiles",
+        )
+    ]
+    for index, record in enumerate(along.directions):
+        if record["hurst"] is None or record["hurst"] != record["hurst"]:
+            text = record["verdict"]
+        else:
+            error = record["hurst_stderr"]
+            spread = "(bound)" if error is None else f"± {error:.4f}"
+            amplitude = format_length(record["amplitude_coefficient"])
+            text = f"H = {record['hurst']:.4f} {spread}   D = {record['fractal_dimension']:.4f}   C = {amplitude}"
+            text += f"   {record['profiles']} profiles"
+        rows.append((f"profiles.directions.{index}", record, PROFILE_UNITS, text, f"θ = {record['angle']:5.1f}°"))
     return rows

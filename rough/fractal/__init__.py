@@ -1,7 +1,13 @@
 """Fractal characterisation and synthesis: power-law spectra, D and C.
 
 The modules: :mod:`rough.fractal.fit` (D and C from the power spectrum),
+:mod:`rough.fractal.scaling` (the spectral model and the band it holds over),
+:mod:`rough.fractal.scales` (roughness against scale, the tip's reliability cut-off),
 :mod:`rough.fractal.rose` (D and C against direction, for maps),
+:mod:`rough.fractal.profiles` (H, D and C of a map's profiles along a direction),
+:mod:`rough.fractal.estimators` (variogram, DFA, wavelet and Higuchi estimators of H),
+:mod:`rough.fractal.calibrate` (their calibration on exact fBm),
+:mod:`rough.fractal.hurst` (every estimator side by side over one band),
 :mod:`rough.fractal.synth` (fractal profiles and maps by spectral synthesis),
 :mod:`rough.fractal.resample` (band-limited resampling, and filling invalid points),
 :mod:`rough.fractal.model` (the spectral model) and :mod:`rough.fractal.psd`

@@ -49,6 +49,7 @@ LOWEST_RING = 4
 RESAMPLED_TOP = 0.8
 EVIDENCE = 1.5  # log-likelihood units in favour of band-limited data before point samples are given up
 FLAT = 1e-9  # RMS residual below this fraction of the largest height is rounding, not roughness
+TIP_SPAN = 8  # a tip's cut-off must leave this many wavelengths of the scan length to fit
 
 
 @dataclasses.dataclass
@@ -95,12 +96,13 @@ class FractalFit:
         ``"power law"`` (D strictly inside the fractal range), ``"at bound"`` (the
         exponent sits on the edge of the range: D is a bound, not an estimate, and
         its standard error is None) or ``"no power-law range"`` (no band of a decade
-        or more passes the goodness-of-fit test: D, C and their errors are NaN).
+        or more keeps its local exponent within the tolerance, docs/math.rst §1.8:
+        D, C and their errors are NaN, and ``scale_dependent`` describes the surface).
     at_bound : bool
         Whether the verdict is ``"at bound"``.
     p_value : float
-        The goodness-of-fit test's p-value over the fit band (see ``test``); NaN for
-        the cross-check methods.
+        The goodness-of-fit test's p-value over the fit band (see ``test``), a
+        diagnostic that does not choose the band; NaN for the cross-check methods.
     test : str
         The goodness-of-fit test (docs/math.rst §1.7).
     fit_band : tuple of float
@@ -121,12 +123,29 @@ class FractalFit:
         for maps; the default band stops below it).
     hint : str or None
         At a bound or without a power-law range: where the spectrum's local exponent
-        comes nearest a fractal's, as a band to try.
+        comes nearest a fractal's, as a band to try (for a band found by the search);
+        for a band given, at a bound, which side of the fractal range the spectrum
+        lies on (never another band: following a hint ends there).
+    band_rule : str
+        How the band was chosen: ``"given"``, or the effect-size rule of the search
+        (docs/math.rst §1.8).
+    scale_dependent : dict or None
+        Without a power-law range: the RMS height, slope and curvature against scale
+        (:func:`rough.fractal.scales.scale_dependent`: lists ``scale`` m,
+        ``rms_height`` m, ``rms_slope``, ``rms_curvature`` 1/m, and ``direction``,
+        ``"profile"`` or ``"x"`` for a map's rows), from the reliability cut-off up;
+        None otherwise.
+    reliability_cutoff : float or None
+        With ``tip_radius``: the wavelength below which the tip cannot follow the
+        surface (:func:`rough.fractal.scales.reliability_cutoff`), metres; the fit
+        left out the frequencies above its inverse. None without a tip radius or
+        when the tip follows the surface at every scale.
 
     Notes
     -----
     ``as_dict()`` gives the fields as a JSON-able dict (``band`` as a list, and no
-    ``profile_dimension`` for a profile).
+    ``profile_dimension`` for a profile, no ``scale_dependent`` with a power law or a
+    bound, no ``reliability_cutoff`` without one).
 
     Examples
     --------
@@ -164,13 +183,17 @@ class FractalFit:
     rolloff_wavelength: float = None
     sampling_source: str = "option"
     hint: str = None
+    band_rule: str = "given"
+    scale_dependent: dict = None
+    reliability_cutoff: float = None
 
     def as_dict(self):
         values = dataclasses.asdict(self)
         values["band"] = None if self.band is None else list(self.band)
         values["fit_band"] = None if self.fit_band is None else list(self.fit_band)
-        if self.profile_dimension is None:
-            del values["profile_dimension"]
+        for name in ("profile_dimension", "scale_dependent", "reliability_cutoff"):
+            if values[name] is None:
+                del values[name]
         return values
 
 
@@ -200,6 +223,7 @@ def fit_fractal(
     noise=True,
     rolloff=False,
     level=0.01,
+    tip_radius=None,
 ):
     """The fractal dimension D (Ds for maps) and amplitude coefficient C of a surface.
 
@@ -214,7 +238,8 @@ def fit_fractal(
         least a decade inside the limits (the given end, else from the lowest
         frequency, for maps the fourth ring, up to the Nyquist frequency for profiles
         and band-limited maps, half of it for point-sampled maps, 80 % of it after
-        rough's resample) over which the model passes the goodness-of-fit test.
+        rough's resample) over which the local exponent stays within 0.1 in H (plus
+        three of its standard errors) of the band's (docs/math.rst §1.8).
     resolution : float, optional
         The η in metres at which C is stated; default the (smaller) spacing.
     method : {"whittle", "variogram", "madogram", "loglog"}, default "whittle"
@@ -241,20 +266,28 @@ def fit_fractal(
         Also fit a Gaussian short-wavelength roll-off ``exp(-(f/fc)²)`` of the power
         law (a tip's or the optics' transfer); 1/fc is reported.
     level : float, default 0.01
-        The goodness-of-fit test's level for the automatic band: the widest band
-        (at least a decade) whose p-value reaches it is fitted.
+        The level of the goodness-of-fit diagnostic: a fit band whose p-value falls
+        below it is logged (at info level) as departing from the model by more than
+        chance. It does not choose the band.
+    tip_radius : float, optional
+        The radius of the stylus tip, metres: the frequencies above 1/λc, where the
+        tip cannot follow the surface (:func:`rough.fractal.scales.reliability_cutoff`,
+        along x for a map), are left out of the fit, and λc is reported.
 
     Returns
     -------
     FractalFit
-        D (or Ds), C, their standard errors, and what the fit used.
+        D (or Ds), C, their standard errors, and what the fit used; without a
+        power-law range, the roughness against scale instead.
 
     Raises
     ------
     rough.InputError
         For invalid points, an unknown method or sampling, a sector for a profile, a
         method other than Whittle for a map, a surface that is flat once its form is
-        removed, or too few frequencies (8) or rings (4) in the band.
+        removed, too few frequencies (8) or rings (4) in the band, a tip radius that
+        is not positive or given with the variogram or madogram, or a tip whose
+        reliability cut-off exceeds an eighth of the scan's length.
 
     Notes
     -----
@@ -303,24 +336,82 @@ def fit_fractal(
         raise InputError(f"sampling must be one of {', '.join(SAMPLINGS)}, not {sampling!r}")
     if not 0 < level < 1:
         raise InputError(f"the test's level must lie between 0 and 1, not {level}")
+    if tip_radius is not None and not tip_radius > 0:
+        raise InputError(f"the tip radius must be positive, not {tip_radius} m")
+    if tip_radius is not None and method in ("variogram", "madogram"):
+        raise InputError(f"the {method} uses lags of 1 and 2 samples only: with a tip radius use whittle or loglog")
     options = Options(noise, rolloff, level)
     source = "option" if sampling else "history" if history_sampling(surface) else None
     sampling = sampling or sampling_of(surface)
     resolution = resolution or min(surface.spacing)
-    if surface.is_profile:
-        if sector is not None:
-            raise InputError("a direction (sector) needs a map")
-        levelled = detrend(surface, order=order).heights
-        refuse_flat(levelled, surface.heights)
-        if method != "whittle":
-            cross_check = {"variogram": _variogram, "madogram": _madogram, "loglog": _loglog}[method]
-            return _announce(cross_check(levelled, surface.spacing[0], band, resolution, sampling))
-        fit = _whittle_profile(levelled, surface, band, resolution, (sampling, source), options)
-        return _announce(fit)
-    if method != "whittle":
+    if surface.is_profile and sector is not None:
+        raise InputError("a direction (sector) needs a map")
+    if not surface.is_profile and method != "whittle":
         raise InputError(f"maps are fitted by the Whittle method only, not {method}")
-    fit = _whittle_map(surface, order, band, resolution, (sampling, source or "maps: band"), sector, options)
-    return fit if sector is not None else _announce(fit)
+    levelled = detrend(surface, order=order).heights if surface.is_profile or tip_radius is not None else None
+    if surface.is_profile:
+        refuse_flat(levelled, surface.heights)
+    cutoff = None if tip_radius is None else tip_cutoff(levelled, surface, tip_radius)
+    if cutoff is not None:
+        band = below_cutoff(surface, band, sampling, cutoff)
+    if surface.is_profile and method != "whittle":
+        cross_check = {"variogram": _variogram, "madogram": _madogram, "loglog": _loglog}[method]
+        fit = cross_check(levelled, surface.spacing[0], band, resolution, sampling)
+    elif surface.is_profile:
+        fit = _whittle_profile(levelled, surface, band, resolution, (sampling, source), options)
+    else:
+        del levelled
+        fit = _whittle_map(surface, order, band, resolution, (sampling, source or "maps: band"), sector, options)
+    fit.reliability_cutoff = cutoff
+    if sector is not None:
+        return fit
+    if fit.verdict == "no power-law range":
+        fit.scale_dependent = _roughness_by_scale(surface, order, cutoff)
+    return announce(fit, level)
+
+
+def tip_cutoff(levelled, surface, tip_radius):
+    """The reliability cut-off of a tip over the levelled heights (a map's rows), m, or
+    None; refused when the tip follows the surface at no scale."""
+    from .scales import reliability_cutoff
+
+    heights = levelled if surface.is_profile else np.atleast_2d(levelled)
+    cutoff = reliability_cutoff(heights, surface.spacing[0], tip_radius)
+    length = heights.shape[-1] * surface.spacing[0]
+    if cutoff is not None and cutoff > length / TIP_SPAN:
+        raise InputError(
+            f"a tip of radius {tip_radius:g} m cannot follow this surface below {cutoff:.4g} m, more than "
+            f"1/{TIP_SPAN} of the scan's length along x ({length:.4g} m): too few scales are left to fit"
+        )
+    if cutoff is not None:
+        log.warning(
+            f"a tip of radius {tip_radius:g} m cannot follow the surface below {cutoff:.4g} m (the curvature "
+            f"criterion): frequencies above {1e-3 / cutoff:.4g}/mm are left out of the fit"
+        )
+    return cutoff
+
+
+def below_cutoff(surface, band, sampling, cutoff):
+    """``band`` with its top at most 1/``cutoff`` (an open top set to the default's)."""
+    low, high = band or (None, None)
+    if high is None:
+        nyquist = 0.5 / surface.spacing[0]
+        high = default_top(surface, nyquist, sampling) if surface.is_profile else map_band(surface, None, sampling)[2]
+    return (low, min(high, 1.0 / cutoff))
+
+
+def _roughness_by_scale(surface, order, cutoff):
+    """The scale-dependent roughness of the levelled surface (a map's rows), from the
+    reliability cut-off up (half its stencil: the step of the second difference)."""
+    from ..metrology import detrend
+    from .scales import scale_dependent
+
+    heights = detrend(surface, order=order).heights
+    spacing = surface.spacing[0]
+    longest = heights.shape[-1] * spacing / 3
+    scales = None if cutoff is None else (max(cutoff / 2, 2 * spacing), longest)
+    table = scale_dependent(heights if surface.is_profile else np.atleast_2d(heights), spacing, scales)
+    return {**table, "direction": "profile" if surface.is_profile else "x"}
 
 
 @dataclasses.dataclass
@@ -347,13 +438,13 @@ def band_outcome(bins, exponent_range, band, options):
 
     if band is not None and None not in band:
         return fit_band(bins, exponent_range, options.noise, options.rolloff)
-    return scaling_range(bins, exponent_range, options.level, noise=options.noise, rolloff=options.rolloff)
+    return scaling_range(bins, exponent_range, noise=options.noise, rolloff=options.rolloff)
 
 
 # -- profiles: Whittle on the differences ------------------------------------------------
 
 
-def _difference_periodogram(heights, spacing):
+def difference_periodogram(heights, spacing):
     """``(f, I)``: the two-sided periodogram Δ/m |DFT|² of the first differences at
     0 < f < the Nyquist frequency (1/m, m²·m)."""
     differences = np.diff(heights)
@@ -364,10 +455,10 @@ def _difference_periodogram(heights, spacing):
 
 
 def _whittle_profile(heights, surface, band, resolution, sampling, options):
-    from .scaling import profile_bins
+    from .scaling import profile_bins, scaling_ranges
 
     spacing = surface.spacing[0]
-    frequencies, ordinates = _difference_periodogram(heights, spacing)
+    frequencies, ordinates = difference_periodogram(heights, spacing)
     top = default_top(surface, 0.5 / spacing, sampling[0])
     keep = _in_band(frequencies, ((band or (None, None))[0], top if band is None or band[1] is None else band[1]))
     if keep.sum() < 8:
@@ -375,16 +466,17 @@ def _whittle_profile(heights, surface, band, resolution, sampling, options):
     frequencies, ordinates = frequencies[keep], ordinates[keep]
     sampling, source = sampling
     samplings = SAMPLINGS if source is None else (sampling,)
-    outcomes = {
-        name: band_outcome(profile_bins(frequencies, spacing, ordinates, name), BETA_RANGE, band, options)
-        for name in samplings
-    }
+    models = {name: profile_bins(frequencies, spacing, ordinates, name) for name in samplings}
+    if band is not None and None not in band:
+        outcomes = {name: band_outcome(bins, BETA_RANGE, band, options) for name, bins in models.items()}
+    else:
+        outcomes = scaling_ranges(models, BETA_RANGE, noise=options.noise, rolloff=options.rolloff)
     sampling, outcome, spread = _likelier(outcomes, spacing, options)
-    return _from_outcome(
+    return from_outcome(
         outcome,
         "profile",
         resolution,
-        _SETTINGS(
+        Settings(
             "whittle",
             "none (first differences)",
             sampling,
@@ -395,7 +487,7 @@ def _whittle_profile(heights, surface, band, resolution, sampling, options):
     )
 
 
-_SETTINGS = dataclasses.make_dataclass("_SETTINGS", ["method", "window", "sampling", "source", "spread", "count"])
+Settings = dataclasses.make_dataclass("Settings", ["method", "window", "sampling", "source", "spread", "count"])
 
 
 def _likelier(outcomes, spacing, options):
@@ -434,12 +526,13 @@ def _likelier(outcomes, spacing, options):
     fit = fit_spectrum(
         profile_bins(frequencies, spacing, density, likelier), BETA_RANGE, options.noise, options.rolloff
     )
-    return likelier, conclude(fit, BETA_RANGE, outcome.best_p, fit.bins.grouped()), spread
+    grid = fit.bins.grouped() if outcome.automatic else None
+    return likelier, conclude(fit, BETA_RANGE, outcome.best_p, grid), spread
 
 
-def _from_outcome(outcome, kind, resolution, settings):
+def from_outcome(outcome, kind, resolution, settings):
     """A :class:`FractalFit` from a scaling outcome (see :mod:`rough.fractal.scaling`)."""
-    from .scaling import TEST_NAME
+    from .scaling import BAND_RULE, TEST_NAME
 
     profile = kind == "profile"
     fit = outcome.fit
@@ -453,6 +546,7 @@ def _from_outcome(outcome, kind, resolution, settings):
         "verdict": outcome.verdict,
         "test": TEST_NAME,
         "p_value": outcome.p_value,
+        "band_rule": BAND_RULE if outcome.automatic else "given",
     }
     if fit is None:
         nan = math.nan
@@ -524,9 +618,10 @@ def refuse_flat(residual, heights):
 UNDEFINED_CHECKED = ("amplitude_coefficient", "psd_prefactor", "structure_function_coefficient")
 
 
-def _announce(fit):
-    """One warning for a verdict other than a power law, and one naming every result
-    that came out undefined (NaN or infinite) although a power law was fitted."""
+def announce(fit, level=0.01):
+    """One warning for a verdict other than a power law, one naming every result that
+    came out undefined (NaN or infinite) although a power law was fitted, and an info
+    line when the goodness-of-fit diagnostic falls below ``level``."""
     dimension = "D" if fit.profile_dimension is None else "Ds"
     if fit.verdict == "at bound":
         log.warning(
@@ -534,8 +629,16 @@ def _announce(fit):
             f"estimate{'; ' + fit.hint if fit.hint else ''}"
         )
     elif fit.verdict == "no power-law range":
-        log.warning(f"no power-law range: {fit.hint or 'no band of a decade passes the test'}")
+        log.warning(
+            f"no power-law range: {fit.hint or 'no band of a decade keeps its local exponent'}; the RMS height, "
+            f"slope and curvature against scale describe the surface instead"
+        )
         return fit
+    if fit.p_value < level:
+        kept = "" if fit.band_rule == "given" else "; the local exponent stays within the band rule's tolerance"
+        log.info(
+            f"the χ² diagnostic rejects an exact power law over the band (p = {fit.p_value:.2g} < {level:g}){kept}"
+        )
     values = {name: getattr(fit, name) for name in UNDEFINED_CHECKED}
     values["band"] = min(fit.band, default=math.nan) if fit.band else math.nan
     undefined = [name for name, value in values.items() if value is None or not math.isfinite(value)]
@@ -592,8 +695,8 @@ def _whittle_map(surface, order, band, resolution, sampling, sector, options):
     outcome = band_outcome(ring_bins(rings, surface.spacing), MAP_RANGE, band, options)
     count = int(outcome.fit.bins.count.sum()) if outcome.fit else int(rings["count"].sum())
     method = "whittle (ring-binned 2-D periodogram)" + ("" if sector is None else ", sector")
-    settings = _SETTINGS(method, "hann (periodic)", sampling[0], sampling[1], 0.0, count)
-    return _from_outcome(outcome, "map", resolution, settings)
+    settings = Settings(method, "hann (periodic)", sampling[0], sampling[1], 0.0, count)
+    return from_outcome(outcome, "map", resolution, settings)
 
 
 def ring_fit(bins, resolution, options):

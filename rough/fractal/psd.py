@@ -235,6 +235,58 @@ def binned_spectrum(surface, order=1, per_decade=10):
     return result
 
 
+def profile_spectrum(heights, spacing, per_decade=10):
+    """The mean Hann periodogram G (m³, one-sided) of several gap-free profiles, in
+    logarithmic bins, with the spread of the profiles about it.
+
+    Parameters
+    ----------
+    heights : list of 1-D arrays
+        Profiles with their form removed (e.g. :attr:`ProfileSet.heights
+        <rough.fractal.profiles.ProfileSet>`), m; NaN is not allowed.
+    spacing : float
+        The sampling step along the profiles, m.
+    per_decade : int, default 10
+        Bins per decade of frequency.
+
+    Returns
+    -------
+    dict
+        Lists per bin: ``frequency`` (geometric mean, 1/m), ``density`` (the mean of
+        every profile's ordinates in the bin, m³), ``count`` (ordinates), ``profiles``
+        (profiles with an ordinate there) and ``log_spread`` (the SD over profiles of
+        log10 of each profile's own bin mean, decades; NaN with one profile).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> walks = [np.cumsum(np.random.default_rng(k).standard_normal(256)) * 1e-9 for k in range(8)]
+    >>> spectrum = profile_spectrum(walks, 1e-6)
+    >>> spectrum["profiles"][-1], 0.0 < spectrum["log_spread"][-1] < 0.5  # eight profiles, within half a decade
+    (8, True)
+    """
+    groups = {}
+    for profile in heights:
+        frequencies, density, _ = periodogram(profile, spacing)
+        keep = frequencies > 0
+        index = np.floor(np.log10(frequencies[keep]) * per_decade + 1e-9).astype(int)
+        for key in np.unique(index):
+            chosen = index == key
+            groups.setdefault(int(key), []).append((frequencies[keep][chosen], density[keep][chosen]))
+    result = {"frequency": [], "density": [], "count": [], "profiles": [], "log_spread": []}
+    for key in sorted(groups):
+        parts = groups[key]
+        frequencies = np.concatenate([f for f, _ in parts])
+        density = np.concatenate([g for _, g in parts])
+        means = np.log10([g.mean() for _, g in parts])
+        result["frequency"].append(float(np.exp(np.mean(np.log(frequencies)))))
+        result["density"].append(float(density.mean()))
+        result["count"].append(int(density.size))
+        result["profiles"].append(len(parts))
+        result["log_spread"].append(float(np.std(means, ddof=1)) if len(parts) > 1 else math.nan)
+    return result
+
+
 def to_surfacetopography(frequencies, density):
     """SurfaceTopography's 1-D PSD: ``(q, C1D)`` with q = 2πf and C1D = G/2."""
     return 2 * np.pi * np.asarray(frequencies), np.asarray(density) / 2

@@ -27,7 +27,17 @@ import math
 import numpy as np
 
 from ..errors import InputError
-from .fit import MAP_RANGE, Options, band_outcome, map_band, refuse_flat, ring_fit, sampling_of
+from .fit import (
+    MAP_RANGE,
+    Options,
+    band_outcome,
+    below_cutoff,
+    map_band,
+    refuse_flat,
+    ring_fit,
+    sampling_of,
+    tip_cutoff,
+)
 from .psd import sector_spectra, windowed_map
 
 log = logging.getLogger("rough")
@@ -113,12 +123,17 @@ class Rose:
         The width of each sector, degrees.
     sampling : str
         ``"point"`` or ``"band-limited"``, as for :func:`~rough.fractal.fit.fit_fractal`.
+    reliability_cutoff : float or None
+        With a tip radius: the wavelength below which the tip cannot follow the
+        surface, metres (the band stops there); None otherwise.
 
     Notes
     -----
     ``as_dict()`` gives the fields as a JSON-able dict: the per-sector lists as
     ``sectors``, one dict per sector (``angle`` and the fields below it), with
-    ``sectors_at_bound`` counting those at a bound, and ``band`` as a list.
+    ``sectors_at_bound`` counting those at a bound, ``band`` as a list, and ``kind``
+    ``"sectors"`` (fits of the 2-D spectrum's sectors, not of 1-D profiles: see
+    :func:`rough.fractal.profiles.profile_rose`).
 
     Examples
     --------
@@ -154,6 +169,7 @@ class Rose:
     step: float
     width: float
     sampling: str
+    reliability_cutoff: float = None
 
     def as_dict(self):
         values = dataclasses.asdict(self)
@@ -161,7 +177,15 @@ class Rose:
         for field in SECTOR_FIELDS:
             for sector, value in zip(sectors, values.pop(field)):
                 sector[field] = value
-        return {"sectors": sectors, "sectors_at_bound": sum(self.at_bound), **values, "band": list(self.band)}
+        if self.reliability_cutoff is None:
+            del values["reliability_cutoff"]
+        return {
+            "kind": "sectors",
+            "sectors": sectors,
+            "sectors_at_bound": sum(self.at_bound),
+            **values,
+            "band": list(self.band),
+        }
 
 
 def rose(
@@ -175,6 +199,7 @@ def rose(
     noise=True,
     rolloff=False,
     level=0.01,
+    tip_radius=None,
 ):
     """D(θ) and C(θ) of a map: the amplitude coefficient rose.
 
@@ -205,6 +230,10 @@ def rose(
         The spectral model and the test, as for :func:`~rough.fractal.fit.fit_fractal`;
         the band is chosen once on the whole map, and every sector gets its own
         noise floor.
+    tip_radius : float, optional
+        A tip radius, metres: the band stops at the wavelength below which such a
+        tip cannot follow the map's rows (as for :func:`~rough.fractal.fit.fit_fractal`),
+        recorded as ``reliability_cutoff``.
 
     Returns
     -------
@@ -257,6 +286,10 @@ def rose(
     sampling = sampling or sampling_of(surface)
     resolution = resolution or min(surface.spacing)
     options = Options(noise, rolloff, level)
+    cutoff = None
+    if tip_radius is not None:
+        cutoff = tip_cutoff(detrend(surface, order=order).heights, surface, tip_radius)
+        band = band if cutoff is None else below_cutoff(surface, band, sampling, cutoff)
     frequency_step, low, high = map_band(surface, band, sampling)
     high = min(high, math.hypot(0.5 / surface.spacing[0], 0.5 / surface.spacing[1]))  # no ring lies beyond the corner
     from scipy import fft
@@ -333,6 +366,7 @@ def rose(
         step=step,
         width=width,
         sampling=sampling,
+        reliability_cutoff=cutoff,
     )
 
 

@@ -22,9 +22,14 @@ standard normal and ``Σ z²`` is χ² with (bins − fitted parameters) degrees
 freedom. The test sees a bend that the power law does not follow (a roll-off, a
 plateau, form left in) wherever it spans a few bins.
 
-The scaling range is the widest band, in decades, over which the model passes this
-test at the level ``level`` with an exponent strictly inside the fractal range and
-the power law above the noise floor over at least ``min_decades``.
+The scaling range is chosen by effect size, not by the test (which, over 10⁴–10⁶
+ordinates, rejects the slight curvature of any real spectrum): it is the widest band
+of at least ``min_decades`` over which the local exponent (the model's exponent
+refitted over every half decade of the grid, the band's noise floor and roll-off held)
+stays within ``TOLERANCE`` of the band's exponent plus ``ALLOWANCE`` of its own
+standard error, with the exponent strictly inside the fractal range and the power law
+above the noise floor over at least ``min_decades``. The test's p-value is kept as a
+diagnostic (docs/math.rst §1.8).
 """
 
 import dataclasses
@@ -37,6 +42,14 @@ NOISE_LOG_RATIO = (-15.0, 15.0)
 POWER_TEST = 13.82  # the 0.1 % point of χ²₂: a floor-only spectrum against floor plus power law
 NOISE_TEST = 9.550  # the 0.1 % point of ½χ²₀ + ½χ²₁, the likelihood ratio of a parameter on its bound
 TEST_NAME = "χ² of probability-integral-transformed bin means (10 bins per decade)"
+TOLERANCE = 0.2  # in the exponent (β or α = 2H + 1 or 2H + 2): 0.1 in H
+ALLOWANCE = 3.0  # standard errors of a local exponent added to the tolerance
+WINDOW = GOF_PER_DECADE // 2  # grid bins in a local fit: half a decade
+SCORING_STEPS = 8
+BAND_RULE = (
+    "widest band of at least a decade whose local exponents (over half a decade and over half the band) "
+    "stay within 0.1 in H plus 3 standard errors of the band's"
+)
 
 
 @dataclasses.dataclass
@@ -364,9 +377,12 @@ def _rolled(fit):
 @dataclasses.dataclass
 class Scaling:
     """The outcome of :func:`scaling_range`: the fit over the chosen band (None when no
-    band passed), its p-value, the band fitted ``(fmin, fmax)`` and the scaling range
-    (up to the noise crossover), 1/m; ``verdict`` is ``"power law"``, ``"at bound"`` or
-    ``"no power-law range"``; ``best_p`` the largest p-value of any band tried."""
+    band qualified), its p-value (a diagnostic), the band fitted ``(fmin, fmax)`` and the
+    scaling range (up to the noise crossover), 1/m; ``verdict`` is ``"power law"``,
+    ``"at bound"`` or ``"no power-law range"``; ``best_p`` the largest p-value of any band
+    tried; ``departure`` the largest local departure over the band in units of the
+    allowance (at most 1 for a band found; NaN for a band given); ``automatic`` whether
+    the band was searched for (a band given gets no band in its hint)."""
 
     fit: SpectralFit
     p_value: float
@@ -375,76 +391,218 @@ class Scaling:
     verdict: str
     best_p: float
     hint: str = None
+    departure: float = math.nan
+    automatic: bool = True
 
 
-def scaling_range(bins, exponent_range, level=0.01, min_decades=1.0, noise=True, rolloff=False):
-    """The widest band of ``bins`` (in decades, on a grid of 10 per decade) over which
-    the model passes the goodness-of-fit test at ``level`` with the exponent strictly
-    inside ``exponent_range`` and the power law above the noise floor over at least
-    ``min_decades``; among equally wide bands, the one with the largest p-value.
-    Only when no band has its exponent inside the range is the widest passing band
-    with the exponent on a bound returned (verdict ``at bound``). The
-    search fits the merged bins; the band chosen is fitted again on the original
-    bins, and is kept only if that fit passes too."""
-    grid = bins.grouped()
-    edges = np.r_[bins.starts(), len(bins)]
-    lowest, highest = bins.frequency[edges[:-1]], bins.frequency[edges[1:] - 1]
-    best_p, bound_choice = 0.0, None
+def local_exponent(part, fit, exponent_range):
+    """``(e, standard error)``: the exponent over the bins ``part`` alone, by Fisher
+    scoring of the gamma likelihood from ``fit``'s exponent and level, with ``fit``'s
+    noise floor and roll-off held (so a local exponent is that of the power law, not of
+    the floor); e stays inside ``exponent_range``. The level is taken at the part's
+    mean log frequency, so level and exponent are nearly uncorrelated. The error is that
+    of the Fisher information at ``fit`` (the band's model, the null hypothesis): inf
+    where the power law is lost under the floor."""
+    low, high = exponent_range
+    exponent = fit.exponent
+    level = math.log(fit.prefactor) + _centre(part, log_power(part, exponent))
+    error = None
+    for _ in range(SCORING_STEPS):
+        information, score = _scoring(part, fit, level, exponent, high)
+        determinant = information[0, 0] * information[1, 1] - information[0, 1] ** 2
+        if not determinant > 0:
+            return exponent, math.inf
+        if error is None:
+            error = math.sqrt(information[0, 0] / determinant)
+        step = np.linalg.solve(information, score)
+        level -= float(np.clip(step[0], -2.0, 2.0))
+        moved = float(np.clip(exponent - np.clip(step[1], -0.5, 0.5), low, high))
+        if abs(moved - exponent) < 1e-4:
+            return moved, error
+        exponent = moved
+    return exponent, error
+
+
+def _centre(part, values):
+    return float(np.sum(part.weight * values) / np.sum(part.weight))
+
+
+def _scoring(part, fit, level, exponent, high):
+    """The Fisher information and the score (gradient of the negative log-likelihood)
+    of (level, e) over ``part``, ``fit``'s noise floor and roll-off held; the level is
+    the power law's mean log over the part."""
+    floor = fit.noise_variance * part.means["noise"]
+    rolled = np.exp(-part.means["f2"] / fit.rolloff**2) if fit.rolloff else 1.0
+    power = log_power(part, exponent)
+    nearby = exponent + (1e-6 if exponent + 1e-6 <= high else -1e-6)
+    slope = (log_power(part, nearby) - power) / (nearby - exponent)
+    power, slope = power - _centre(part, power), slope - _centre(part, slope)
+    signal = np.exp(level + power) * rolled
+    expected = signal + floor
+    share = signal / expected
+    gradient = np.array([share, share * slope])
+    information = (gradient * part.weight) @ gradient.T
+    return information, gradient @ (part.weight * (1.0 - part.density / expected))
+
+
+def departure(grid, fit, exponent_range, tolerance=TOLERANCE, limit=math.inf):
+    """The largest ``|e_local - e| / (tolerance + ALLOWANCE · error)`` over the windows
+    of ``grid`` (bins of 10 per decade) half a decade wide and half the band wide,
+    sliding by one bin: a band qualifies when it is at most 1 (past ``limit`` the
+    search stops and returns what it has). The short windows see a
+    bend where the ordinates are few (a local fit is led by its densest, highest
+    frequencies), the long ones a gentle drift where they are many. Windows above the
+    noise crossover, where the floor swamps the power law, count with their large
+    errors."""
     size = len(grid)
-    for width in range(size, 0, -1):
-        passing = []
-        for first in range(0, size - width + 1):
-            low, high = lowest[first], highest[first + width - 1]
-            if decades(low, high) < min_decades or width <= 4:
+    if size < WINDOW:
+        return math.inf
+    worst = 0.0
+    for window in sorted({max(WINDOW, size // 2), WINDOW}, reverse=True):
+        for first in range(size - window + 1):
+            exponent, error = local_exponent(grid.part(first, first + window), fit, exponent_range)
+            worst = max(worst, abs(exponent - fit.exponent) / (tolerance + ALLOWANCE * error))
+            if worst > limit:
+                return worst
+    return worst
+
+
+def scaling_range(bins, exponent_range, min_decades=1.0, noise=True, rolloff=False, tolerance=TOLERANCE):
+    """The widest band of ``bins`` (in decades, on a grid of 10 per decade) of at least
+    ``min_decades`` over which every half-decade's local exponent stays within
+    ``tolerance`` (plus ``ALLOWANCE`` standard errors) of the band's, with the exponent
+    strictly inside ``exponent_range`` and the power law above the noise floor over at
+    least ``min_decades``; among equally wide bands, the one with the smallest
+    departure. Only when no band has its exponent inside the range is the widest such
+    band with the exponent on a bound returned (verdict ``at bound``). The search fits
+    the merged bins; the band chosen is fitted again on the original bins, and is kept
+    only if that fit qualifies too. The goodness-of-fit p-value plays no part in the
+    choice: it is a diagnostic (see :class:`Scaling`)."""
+    return scaling_ranges({None: bins}, exponent_range, min_decades, noise, rolloff, tolerance)[None]
+
+
+def scaling_ranges(models, exponent_range, min_decades=1.0, noise=True, rolloff=False, tolerance=TOLERANCE):
+    """:func:`scaling_range` for several models of the same ordinates (``{name: bins}``,
+    e.g. a profile's two sampling models), searched together from the widest band
+    down: the search stops at the first width at which any model has a band with its
+    exponent inside the range, and a model with none there gets ``"no power-law
+    range"`` (its best band could only be narrower). Returns ``{name: Scaling}``."""
+    searches = {
+        name: _Search(bins, exponent_range, (noise, rolloff, tolerance), min_decades) for name, bins in models.items()
+    }
+    size = len(next(iter(searches.values())).grid)
+    for width in range(size, WINDOW - 1, -1):
+        found = {name: search.at_width(width) for name, search in searches.items()}
+        if any(found.values()):
+            return {
+                name: outcome or search.nothing() for (name, outcome), search in zip(found.items(), searches.values())
+            }
+    return {name: search.conclusion() for name, search in searches.items()}
+
+
+class _Search:
+    """The band search of one model over its grid (see :func:`scaling_range`)."""
+
+    def __init__(self, bins, exponent_range, model, min_decades):
+        self.bins, self.exponent_range, self.model, self.min_decades = bins, exponent_range, model, min_decades
+        self.grid = bins.grouped()
+        self.edges = np.r_[bins.starts(), len(bins)]
+        self.lowest = bins.frequency[self.edges[:-1]]
+        self.highest = bins.frequency[self.edges[1:] - 1]
+        self.best_p, self.bound_choice = 0.0, None
+
+    def at_width(self, width):
+        """The outcome of the best qualifying band ``width`` grid bins wide with its
+        exponent inside the range, or None."""
+        noise, rolloff, tolerance = self.model
+        qualifying = []
+        for first in range(0, len(self.grid) - width + 1):
+            low, high = self.lowest[first], self.highest[first + width - 1]
+            if decades(low, high) < self.min_decades:
                 continue
-            part = grid.part(first, first + width)
-            fit = fit_spectrum(part, exponent_range, noise, rolloff)
+            part = self.grid.part(first, first + width)
+            fit = fit_spectrum(part, self.exponent_range, noise, rolloff)
             p = fit.p_value()
-            best_p = max(best_p, p if math.isfinite(p) else 0.0)
+            self.best_p = max(self.best_p, p if math.isfinite(p) else 0.0)
             span = (low, min(high, fit.crossover()))
-            if p < level or decades(*span) < min_decades or not power_law_found(fit):
+            if decades(*span) < self.min_decades or not power_law_found(fit):
                 continue
-            if at_bound(fit.exponent, exponent_range):
-                bound_choice = bound_choice or (first, width)
+            bound = at_bound(fit.exponent, self.exponent_range)
+            if bound and self.bound_choice:
+                continue
+            worst = departure(part, fit, self.exponent_range, tolerance, limit=1.0)
+            if worst > 1:
+                continue
+            if bound:
+                self.bound_choice = (first, width)
             else:
-                passing.append((p, first))
-        for p, first in sorted(passing, reverse=True):
-            outcome = _final(bins, edges, first, width, exponent_range, noise, rolloff, best_p, grid)
-            if outcome.p_value >= level and outcome.verdict == "power law":
+                qualifying.append((worst, first))
+        for _, first in sorted(qualifying):
+            outcome = self.final(first, width)
+            if outcome.verdict == "power law" and outcome.departure <= 1:
                 return outcome
-    if bound_choice:
-        return _final(bins, edges, *bound_choice, exponent_range, noise, rolloff, best_p, grid)
-    hint = nearest_fractal(grid, exponent_range, min_decades)
-    return Scaling(None, best_p, None, None, "no power-law range", best_p, hint)
+        return None
 
+    def final(self, first, width):
+        """The model fitted to the original bins of grid bins ``first`` … ``first +
+        width``, with its departure over those grid bins."""
+        noise, rolloff, tolerance = self.model
+        part = self.bins.part(self.edges[first], self.edges[first + width])
+        fit = fit_spectrum(part, self.exponent_range, noise, rolloff)
+        outcome = conclude(fit, self.exponent_range, self.best_p, self.grid)
+        outcome.departure = departure(self.grid.part(first, first + width), fit, self.exponent_range, tolerance)
+        return outcome
 
-def _final(bins, edges, first, width, exponent_range, noise, rolloff, best_p, grid):
-    """The model fitted to the original bins of grid bins ``first`` … ``first + width``."""
-    part = bins.part(edges[first], edges[first + width])
-    return conclude(fit_spectrum(part, exponent_range, noise, rolloff), exponent_range, best_p, grid)
+    def nothing(self):
+        hint = nearest_fractal(self.grid, self.exponent_range, self.min_decades)
+        return Scaling(None, self.best_p, None, None, "no power-law range", self.best_p, hint)
+
+    def conclusion(self):
+        """After the whole search: the widest qualifying band at a bound, or nothing."""
+        return self.final(*self.bound_choice) if self.bound_choice else self.nothing()
 
 
 def fit_band(bins, exponent_range, noise=True, rolloff=False):
     """The model fitted to all of ``bins`` (a band the user chose), as a
-    :class:`Scaling` whose verdict does not depend on the test."""
-    return conclude(fit_spectrum(bins, exponent_range, noise, rolloff), exponent_range, math.nan, bins.grouped())
+    :class:`Scaling` whose verdict does not depend on the test; at a bound its hint
+    names no other band (following a hint never leads to another). Where the floor
+    alone explains the band, the power law is fitted without it (white noise is then
+    a bound: flatter than any fractal), not as an arbitrary slope under the floor."""
+    fit = fit_spectrum(bins, exponent_range, noise, rolloff)
+    if not power_law_found(fit):
+        fit = fit_spectrum(bins, exponent_range, False, rolloff)  # the floor alone: the band's own slope
+    return conclude(fit, exponent_range, math.nan, None)
 
 
 def conclude(fit, exponent_range, best_p, grid):
     """A :class:`Scaling` from a fit over its bins: the verdict from where the exponent
-    lies, and at a bound the hint from ``grid`` (the bins the search had)."""
+    lies, and at a bound the hint: from ``grid`` (the bins the search had) a band to
+    try, or with ``grid`` None (a band given) which side of the range the spectrum
+    lies on."""
     frequencies = fit.bins.frequency
     band = (float(frequencies[0]), float(frequencies[-1]))
     span = (band[0], float(min(band[1], max(fit.crossover(), band[0]))))
     bound = at_bound(fit.exponent, exponent_range)
-    hint = nearest_fractal(grid, exponent_range) if bound else None
-    return Scaling(fit, fit.p_value(), band, span, "at bound" if bound else "power law", best_p, hint)
+    hint = None
+    if bound:
+        hint = nearest_fractal(grid, exponent_range) if grid is not None else _side(fit.exponent, exponent_range)
+    verdict = "at bound" if bound else "power law"
+    return Scaling(fit, fit.p_value(), band, span, verdict, best_p, hint, automatic=grid is not None)
+
+
+def _side(exponent, exponent_range):
+    steeper = abs(exponent - exponent_range[1]) < abs(exponent - exponent_range[0])
+    return (
+        f"over this band the spectrum is {'steeper' if steeper else 'flatter'} than any fractal's "
+        f"(D at the {'lower' if steeper else 'upper'} end of its range)"
+    )
 
 
 def nearest_fractal(grid, exponent_range, decades=1.0):
     """A hint: the band of ``decades`` whose local exponent (a least-squares line through
     the log of the bin means, the exponent-free part of the shape taken out) comes
-    nearest the middle of ``exponent_range``, and that exponent."""
+    nearest the middle of ``exponent_range``, and that exponent; a band to try only
+    when that exponent lies inside the range."""
     log_f = grid.means["log_f"]
     level = np.log(grid.density) - grid.means["shape"]
     middle = sum(exponent_range) / 2
@@ -460,6 +618,11 @@ def nearest_fractal(grid, exponent_range, decades=1.0):
         return "the spectrum spans less than a decade: use more points or a longer scan"
     slope, first, stop = best
     low, high = math.exp(log_f[first]) * 1e-3, math.exp(log_f[stop]) * 1e-3
+    if not exponent_range[0] < slope < exponent_range[1]:
+        return (
+            f"the local exponent lies outside a fractal's range at every scale (nearest {slope:.2f}, over "
+            f"{low:.4g}/mm to {high:.4g}/mm)"
+        )
     return (
         f"the local exponent comes nearest a fractal's ({slope:.2f}) over {low:.4g}/mm to {high:.4g}/mm: "
         f"try --band {low:.4g}/mm:{high:.4g}/mm"

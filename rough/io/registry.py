@@ -19,6 +19,7 @@ from ..errors import FormatError
 MODULES = (
     "xlsx",
     "nmm",
+    "npz",
     "x3p",
     "exr",
     "gsf",
