@@ -162,13 +162,13 @@ def fit_fractal(
 def _profiles_report(surface, input, direction, gaps, model, psd_file, plot, report):
     """The pooled Whittle fit of the profiles along ``direction``; ``--psd`` writes and
     ``--plot`` draws their mean spectrum with the per-profile spread."""
-    from ..fractal.profiles import fit_profiles, take_profiles
+    from ..fractal.profiles import fit_profiles
     from ..fractal.psd import profile_spectrum
 
     result = fit_profiles(surface, direction, gaps, **model)
     document = result.as_dict()
     if psd_file or plot:
-        profiles = take_profiles(surface, direction, gaps, model["order"])
+        profiles = result.profile_set
         spectrum = profile_spectrum(profiles.heights, profiles.spacing)
         if psd_file:
             _write_psd(

@@ -36,8 +36,6 @@ REPLICATES = (10, 400)  # the default number of replicates lies in this range
 WHITTLE_BUDGET = 1_000_000  # the same for the Whittle fit, which costs far more per replicate
 WHITTLE_REPLICATES = (4, 16)
 CHUNK = 2**20  # synthetic heights made at once
-MIN_BLOCKS = 8  # the block jackknife needs at least this many blocks (of one profile or more)
-MAX_BLOCKS = 16
 _CURVES = {}
 
 
@@ -283,23 +281,22 @@ def invert(curve, raw, floor=0.0):
 
 def block_spread(name, profiles, spacing, scales, positions, noisy=True):
     """The delete-one-block jackknife SD of the raw Ĥ (the Whittle fit with a noise
-    floor only for ``noisy`` data), or None with fewer than
-    :data:`MIN_BLOCKS` profiles. Blocks: the profiles sorted by ``positions`` (offsets
-    across, m; ties in the given order) cut into min(16, count) runs of neighbours, as
-    :mod:`rough.fractal.profiles` does for its standard errors."""
+    floor only for ``noisy`` data), or None with too few profiles for the blocks of
+    :func:`rough.fractal.profiles.neighbour_blocks` (the blocks of neighbours whose
+    jackknife gives the pooled fit's standard errors)."""
+    from .profiles import jackknife_variance, neighbour_blocks
+
     positions = np.asarray(positions, dtype=float)
     if positions.shape != (len(profiles),) or not np.isfinite(positions).all():
         raise InputError("positions must give one finite offset per profile")
-    count = min(MAX_BLOCKS, len(profiles))
-    if count < MIN_BLOCKS:
+    blocks = neighbour_blocks(positions)
+    if blocks is None:
         return None
-    blocks = np.array_split(np.argsort(positions, kind="stable"), count)
     leave_out = []
     for block in blocks:
         kept = np.setdiff1d(np.arange(len(profiles)), block)
         leave_out.append(_estimate(name, [profiles[i] for i in kept], spacing, scales, noisy).hurst)
-    leave_out = np.array(leave_out)
-    return float(np.sqrt((count - 1) / count * np.sum((leave_out - leave_out.mean()) ** 2)))
+    return float(math.sqrt(jackknife_variance(leave_out)))
 
 
 def calibrated(

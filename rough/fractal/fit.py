@@ -402,15 +402,11 @@ def below_cutoff(surface, band, sampling, cutoff):
 
 def _roughness_by_scale(surface, order, cutoff):
     """The scale-dependent roughness of the levelled surface (a map's rows), from the
-    reliability cut-off up (half its stencil: the step of the second difference)."""
+    reliability cut-off up."""
     from ..metrology import detrend
     from .scales import scale_dependent
 
-    heights = detrend(surface, order=order).heights
-    spacing = surface.spacing[0]
-    longest = heights.shape[-1] * spacing / 3
-    scales = None if cutoff is None else (max(cutoff / 2, 2 * spacing), longest)
-    table = scale_dependent(heights if surface.is_profile else np.atleast_2d(heights), spacing, scales)
+    table = scale_dependent(detrend(surface, order=order).heights, surface.spacing[0], cutoff=cutoff)
     return {**table, "direction": "profile" if surface.is_profile else "x"}
 
 

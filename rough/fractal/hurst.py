@@ -19,7 +19,7 @@ import numpy as np
 from ..errors import InputError
 from .calibrate import QUANTILE, Calibrated, compare, largest_noise
 from .estimators import ESTIMATORS, SCALINGS, sample_scales
-from .profiles import fit_profiles, take_profiles
+from .profiles import fit_profiles
 
 log = logging.getLogger("rough")
 
@@ -150,7 +150,6 @@ def hurst_exponents(
     [('whittle', 0.7), ('dfa', 0.7)]
     """
     names = list(ESTIMATORS) if estimators is None else list(estimators)
-    profiles = take_profiles(surface, direction, gaps, order)
     profile_fit = fit_profiles(
         surface,
         direction,
@@ -164,31 +163,26 @@ def hurst_exponents(
         level=level,
         tip_radius=tip_radius,
     )
-    fit = profile_fit.fit
+    fit, profiles = profile_fit.fit, profile_fit.profile_set
     scales = (1.0 / fit.band[1], 1.0 / fit.band[0]) if fit.band else None
     fitted = (1.0 / fit.fit_band[1], 1.0 / fit.fit_band[0]) if fit.fit_band else None
     chosen = band is not None or tip_radius is not None
-    noise_rms = _calibrated_noise(fit.noise_rms, profiles.heights)
     lengths = np.array([profile.size for profile in profiles.heights])
+    design = {
+        "noise_rms": _calibrated_noise(fit.noise_rms, profiles.heights),
+        "replicates": replicates,
+        "seed": seed,
+        "order": order,
+        "positions": profiles.positions if len(profiles.heights) > 1 else None,
+        "sampling": fit.sampling,
+    }
     found = {}
     for name in names:
         if name == "whittle":
             own = fitted
         else:
             own = scales if chosen else _own_range(name, lengths, profiles.spacing, scales)
-        found[name] = _calibrated(
-            estimators is None,
-            name,
-            profiles.heights,
-            profiles.spacing,
-            own,
-            noise_rms,
-            replicates,
-            seed,
-            order,
-            profiles.positions if len(profiles.heights) > 1 else None,
-            fit.sampling,
-        )
+        found[name] = _calibrated(name, profiles, own, design, side_by_side=estimators is None)
     return HurstTable(profile_fit, [found[name] for name in names], scales)
 
 
@@ -221,12 +215,12 @@ def _calibrated_noise(noise_rms, heights):
     return None
 
 
-def _calibrated(side_by_side, name, heights, spacing, scales, *rest):
+def _calibrated(name, profiles, scales, design, side_by_side):
     """One estimator's calibrated H; side by side with the others, an estimator that
     cannot measure these profiles (too few scales, say) is recorded as refused, with
     the reason, instead of refusing the whole table."""
     try:
-        return compare(heights, spacing, scales, rest[0], [name], *rest[1:])[0]
+        return compare(profiles.heights, profiles.spacing, scales, estimators=[name], **design)[0]
     except InputError as error:
         if not side_by_side:
             raise

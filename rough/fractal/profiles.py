@@ -380,12 +380,15 @@ class ProfileFit:
         follows at every scale.
     kind : str
         ``"profiles"``: a 1-D fit of profiles, not of the map's 2-D spectrum.
+    profile_set : ProfileSet
+        The profiles fitted (their heights with the form removed), for what else is
+        measured on them: their mean spectrum, other estimators.
 
     Notes
     -----
     ``as_dict()`` merges the fields of ``fit`` (``fractal_dimension``,
     ``amplitude_coefficient``, ``hurst``, ``band``, …) with these (``angle`` None for
-    a profile).
+    a profile; not ``profile_set``).
     """
 
     fit: object
@@ -401,10 +404,11 @@ class ProfileFit:
     design_effect: float = 1.0
     reliability_cutoff: float = None
     kind: str = "profiles"
+    profile_set: object = dataclasses.field(default=None, repr=False)
 
     def as_dict(self):
         values = {name: getattr(self, name) for name in (field.name for field in dataclasses.fields(self))}
-        del values["fit"]
+        del values["fit"], values["profile_set"]
         values["angle"] = None if math.isnan(self.angle) else self.angle
         return {**self.fit.as_dict(), **values}
 
@@ -509,7 +513,7 @@ def fit_profiles(
     periodograms = _periodograms(profiles.heights, profiles.spacing)
     if _pooled(periodograms, profiles.spacing, limits, sampling) is None:
         raise InputError("fewer than 8 frequencies in the fit band; widen --band or use longer profiles")
-    blocks = _blocks(profiles.positions)
+    blocks = neighbour_blocks(profiles.positions)
     effect = _design_effect(periodograms, blocks, profiles.spacing, limits, sampling)
     bins = _pooled(periodograms, profiles.spacing, limits, sampling, effect)
     options = Options(noise, rolloff, level)
@@ -540,17 +544,16 @@ def fit_profiles(
         stderr_method=errors["method"],
         design_effect=effect,
         reliability_cutoff=cutoff,
+        profile_set=profiles,
     )
 
 
 def _by_scale(profiles, cutoff):
-    """The profiles' roughness against scale (where no band is a power law), from half
-    the tip's cut-off up."""
+    """The profiles' roughness against scale (where no band is a power law), from the
+    tip's cut-off up."""
     from .scales import scale_dependent
 
-    longest = max(profile.size for profile in profiles.heights) * profiles.spacing / 3
-    scales = None if cutoff is None else (max(cutoff / 2, 2 * profiles.spacing), longest)
-    return {**scale_dependent(profiles.heights, profiles.spacing, scales), "direction": profiles.label}
+    return {**scale_dependent(profiles.heights, profiles.spacing, cutoff=cutoff), "direction": profiles.label}
 
 
 def _cutoff(profiles, tip_radius):
@@ -575,7 +578,7 @@ def _limits(profiles, surface, band, cutoff):
     return (0.0 if low is None else low), high
 
 
-def _blocks(positions):
+def neighbour_blocks(positions):
     """The profiles' indices in blocks of neighbours (sorted by position, ties in the
     given order): JACKKNIFE_BLOCKS of them, one profile each between MIN_BLOCKS and
     JACKKNIFE_BLOCKS profiles; None with fewer than MIN_BLOCKS profiles."""
@@ -598,7 +601,9 @@ def _replicates(periodograms, blocks, spacing, band, sampling, noise, rolloff):
     return fits if len(fits) >= MIN_BLOCKS else None
 
 
-def _jackknife_variance(values):
+def jackknife_variance(values):
+    """The delete-one jackknife variance of the estimates ``values`` (one per left-out
+    block; along the first axis)."""
     values = np.asarray(values, dtype=np.float64)
     count = values.shape[0]
     return (count - 1) / count * np.sum((values - values.mean(axis=0)) ** 2, axis=0)
@@ -617,7 +622,7 @@ def _design_effect(periodograms, blocks, spacing, band, sampling):
     replicates = _replicates(periodograms, blocks, spacing, band, sampling, False, False)
     if replicates is None:
         return 1.0
-    ratio = _jackknife_variance([fit.exponent for fit in replicates]) / whole.covariance[1, 1]
+    ratio = jackknife_variance([fit.exponent for fit in replicates]) / whole.covariance[1, 1]
     return float(min(max(ratio, 1.0), len(periodograms)))
 
 
@@ -641,7 +646,7 @@ def _uncertainty(profiles, periodograms, blocks, outcome, fit, sampling, options
     for replicate in replicates:
         dimension = (5.0 - replicate.exponent) / 2.0
         estimates.append((dimension, math.log(model.amplitude(replicate.prefactor, dimension, fit.resolution))))
-    variance = _jackknife_variance(estimates)
+    variance = jackknife_variance(estimates)
     return {
         "hurst": float(math.sqrt(variance[0])),
         "amplitude": float(fit.amplitude_coefficient * math.sqrt(variance[1])),

@@ -26,7 +26,7 @@ PER_DECADE = 10
 SAFETY = 0.5  # SurfaceTopography's safety factor: a tip fails where the curvature reaches -SAFETY/R
 
 
-def scale_dependent(heights, spacing, scales=None):
+def scale_dependent(heights, spacing, scales=None, cutoff=None):
     """RMS height, slope and curvature of profiles against scale.
 
     Parameters
@@ -39,6 +39,10 @@ def scale_dependent(heights, spacing, scales=None):
     scales : tuple of float, optional
         ``(λmin, λmax)`` in metres; default from 2 spacings to a third of the
         longest profile. The scales are whole numbers of spacings, 10 per decade.
+    cutoff : float, optional
+        A tip's reliability cut-off (:func:`reliability_cutoff`), metres: without
+        ``scales``, the scales start at half of it (the step of the second difference
+        whose stencil it is), not below 2 spacings.
 
     Returns
     -------
@@ -58,7 +62,7 @@ def scale_dependent(heights, spacing, scales=None):
         raise InputError(f"the spacing must be positive, not {spacing}")
     longest = max(group.shape[1] for group in groups)
     table = {"scale": [], "rms_height": [], "rms_slope": [], "rms_curvature": []}
-    for step in _steps(longest, spacing, scales):
+    for step in _steps(longest, spacing, scales, cutoff):
         usable = [group for group in groups if group.shape[1] > 2 * step]
         if not usable:
             continue
@@ -180,10 +184,10 @@ def _difference(group, step, order):
     return group[:, 2 * step :] - 2 * group[:, step:-step] + group[:, : -2 * step]
 
 
-def _steps(longest, spacing, scales):
-    """Whole numbers of spacings, 10 per decade, from 2 (or λmin) to a third of the
-    longest profile (or λmax)."""
-    low, high = scales or (2 * spacing, longest * spacing / 3)
+def _steps(longest, spacing, scales, cutoff=None):
+    """Whole numbers of spacings, 10 per decade, from 2 (or half the cut-off, or λmin)
+    to a third of the longest profile (or λmax)."""
+    low, high = scales or (max(2 * spacing, (cutoff or 0.0) / 2), longest * spacing / 3)
     first = max(1, math.ceil(low / spacing - 1e-9))
     last = min((longest - 1) // 2, math.floor(high / spacing + 1e-9))
     if last < first:
