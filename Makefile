@@ -53,11 +53,11 @@ demo-pipeline:
 	@echo '$$ rough fit-fractal --plot $(DEMO)/psd.png sample_profiles/rock-profile.tsv'
 	@$(BIN)/rough fit-fractal --plot $(DEMO)/psd.png sample_profiles/rock-profile.tsv
 	@echo
-	@echo '$$ rough synth --length 80mm --dimension 1.275 --rq 0.2781mm --seed 1 | rough resample --spacing 0.1545mm | rough fit-fractal'
-	@$(BIN)/rough synth --length 80mm --dimension 1.275 --rq 0.2781mm --seed 1 | $(BIN)/rough resample --spacing 0.1545mm | $(BIN)/rough fit-fractal
+	@echo '$$ rough synth --length 80mm --dimension 1.275 --rq 0.2781mm --seed 1 | rough resample --step 0.1545mm | rough fit-fractal'
+	@$(BIN)/rough synth --length 80mm --dimension 1.275 --rq 0.2781mm --seed 1 | $(BIN)/rough resample --step 0.1545mm | $(BIN)/rough fit-fractal
 	@echo
-	@echo '$$ rough synth --size 512x512 --spacing 10um --anisotropy 2.2,1um,2.5,3um,30 --seed 1 | rough rose --step 30 --plot $(DEMO)/rose.png'
-	@$(BIN)/rough synth --size 512x512 --spacing 10um --anisotropy 2.2,1um,2.5,3um,30 --seed 1 | $(BIN)/rough rose --step 30 --plot $(DEMO)/rose.png
+	@echo '$$ rough synth --size 512x512 --step 10um --anisotropy 2.2,1um,2.5,3um,30 --seed 1 | rough rose --angle-step 30 --plot $(DEMO)/rose.png'
+	@$(BIN)/rough synth --size 512x512 --step 10um --anisotropy 2.2,1um,2.5,3um,30 --seed 1 | $(BIN)/rough rose --angle-step 30 --plot $(DEMO)/rose.png
 	@echo
 	@echo '$$ rough render --speed 20mm/s --speed 120mm/s --plot $(DEMO)/forces.png sample_profiles/rock-profile.tsv   (the simulated hand)'
 	@$(BIN)/rough render --speed 20mm/s --speed 120mm/s --plot $(DEMO)/forces.png sample_profiles/rock-profile.tsv

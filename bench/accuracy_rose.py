@@ -8,8 +8,8 @@ import math
 
 import numpy as np
 
-from rough.fractal.rose import rose
-from rough.fractal.synth import synthesize_map
+from rough.fractal.sectors import rose
+from rough.fractal.synth_map import synthesize_map
 
 
 def isotropic(maps=60):

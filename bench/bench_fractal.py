@@ -22,8 +22,8 @@ from timing import compare
 
 import rough
 from rough.fractal.fit import fit_fractal
-from rough.fractal.rose import rose
-from rough.fractal.synth import synthesize_map
+from rough.fractal.sectors import rose
+from rough.fractal.synth_map import synthesize_map
 
 
 def main():

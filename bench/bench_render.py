@@ -16,8 +16,8 @@ import time
 from timing import Comparison
 
 from rough import __version__
-from rough.fractal.resample import resample
-from rough.fractal.synth import synthesize_map, synthesize_profile
+from rough.fractal import synthesize_map, synthesize_profile
+from rough.fractal.resampling import resample
 from rough.render import (
     DynamicStylus,
     GradientField,

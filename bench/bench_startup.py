@@ -39,7 +39,7 @@ def main():
             repeat,
             goal="≤ 1.5×",
         )
-    synth = [*cli, "synth", "--size", "128x96", "--spacing", "10um", "--dimension", "2.3", "--rq", "1um", "--seed", "1"]
+    synth = [*cli, "synth", "--size", "128x96", "--step", "10um", "--dimension", "2.3", "--rq", "1um", "--seed", "1"]
     compare("rough synth --size 128x96 --rq 1um", command(synth), libraries, "import numpy, scipy", repeat)
 
 

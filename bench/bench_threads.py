@@ -13,7 +13,7 @@ import sys
 
 FIT = """
 import time, numpy as np
-from rough.fractal.profiles import whittle_hurst
+from rough.fractal.pooled import whittle_hurst
 walk = np.cumsum(np.random.default_rng(1).standard_normal(1024))
 heights = [walk - np.polyval(np.polyfit(np.arange(1024), walk, 1), np.arange(1024))]
 whittle_hurst(heights, 1.0)

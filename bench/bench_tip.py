@@ -18,7 +18,7 @@ import numpy as np
 from timing import compare
 
 from rough import Surface, __version__
-from rough.fractal.synth import synthesize_map, synthesize_profile
+from rough.fractal import synthesize_map, synthesize_profile
 from rough.metrology.tip import closing_envelope, traced
 
 SPACING, RADIUS = 1e-5, 0.5e-3

@@ -45,7 +45,7 @@ def cases():
     yield "profile 1024", [without_line(fbm(1024, 0.7, rng, 1e-6, 1e-6))], 1e-6
     yield "profile 4096", [without_line(fbm(4096, 0.7, rng, 1e-6, 1e-6))], 1e-6
     if CORONA.is_file():
-        from rough.fractal.profiles import take_profiles
+        from rough.fractal.profile_set import take_profiles
 
         grid = np.load(CORONA)["Z_grid"]
         rows = take_profiles(rough.Surface(grid, (CORONA_SPACING, CORONA_SPACING)), "x").heights

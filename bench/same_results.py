@@ -23,9 +23,9 @@ import numpy as np
 
 import rough
 from rough.errors import InputError
+from rough.fractal import synthesize_map, synthesize_profile
 from rough.fractal.fit import fit_fractal
-from rough.fractal.rose import rose
-from rough.fractal.synth import synthesize_map, synthesize_profile
+from rough.fractal.sectors import rose
 from rough.metrology import feature_parameters, functional_parameters, parameters
 
 SKIPPED = (".md", ".json", ".txt", ".py")

@@ -14,14 +14,16 @@ Read a scan, remove its form, and compute its ISO parameters and fractal dimensi
 True
 
 Every function takes and returns SI units (metres, seconds, newtons) and marks invalid
-points with NaN. The names below load their modules on first use, so ``import rough``
-is cheap and the command line starts quickly. ``rough.metrology``, ``rough.fractal``,
-``rough.render`` and ``rough.experiment`` hold the rest of the library.
+points with NaN. The names in ``__init__.pyi`` beside this file load their modules on
+first use (``lazy_loader``, as scikit-image does), so ``import rough`` is cheap and the
+command line starts quickly. ``rough.metrology``, ``rough.fractal``, ``rough.render``
+and ``rough.experiment`` hold the rest of the library.
 """
 
-import importlib
 import os
 import sys
+
+import lazy_loader
 
 # OpenBLAS's worker threads cost more than they give in the small solves and optimisers of
 # the fits: on a busy 2-core machine an L-BFGS-B fit took 20 times longer with them
@@ -30,48 +32,8 @@ import sys
 if "numpy" not in sys.modules:
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
-__version__ = "0.11.0"
+__version__ = "0.12.0"
 
-# public name -> module that defines it (imported on first use)
-_LAZY = {
-    "Surface": "rough.surface",
-    "Units": "rough.surface",
-    "read": "rough.io",
-    "write": "rough.io",
-    "sample": "rough.samples",
-    "detrend": "rough.metrology",
-    "parameters": "rough.metrology",
-    "profile_parameters": "rough.metrology",
-    "areal_parameters": "rough.metrology",
-    "mean_line": "rough.metrology",
-    "detect_features": "rough.metrology",
-    "rq_versus_length": "rough.metrology",
-    "traced": "rough.metrology.tip",
-    "closing_envelope": "rough.metrology.tip",
-    "fit_fractal": "rough.fractal.fit",
-    "FractalFit": "rough.fractal.fit",
-    "rose": "rough.fractal.rose",
-    "Rose": "rough.fractal.rose",
-    "synthesize_profile": "rough.fractal.synth",
-    "synthesize_map": "rough.fractal.synth",
-    "resample": "rough.fractal.resample",
-    "Track": "rough.render",
-    "simulate": "rough.render",
-    "forces": "rough.render",
-    "RoughError": "rough.errors",
-    "InputError": "rough.errors",
-}
-
-__all__ = ["__version__", *_LAZY]
-
-
-def __getattr__(name):
-    if name in _LAZY:
-        value = getattr(importlib.import_module(_LAZY[name]), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module 'rough' has no attribute {name!r}")
-
-
-def __dir__():
-    return sorted({*globals(), *__all__})
+__getattr__, _, __all__ = lazy_loader.attach_stub(__name__, __file__)
+__all__ = ["__version__", *__all__]
+__dir__ = __all__.copy  # dir(rough): the stub's names and the version

@@ -1,5 +1,5 @@
 """``python -m rough`` is the ``rough`` command."""
 
-from .cli import main
+from .cli.launch import main
 
 main()

@@ -39,7 +39,7 @@ def compiled(function):
     >>> compiled(twice)(21)
     42
     """
-    import numba
+    import numba  # numba: only when compiled
 
     try:
         dispatcher = numba.njit(nogil=True, cache=True, error_model="numpy")(function)

@@ -86,7 +86,7 @@ def progress(iterable=None, *, total=None, description="", unit="step"):
 def _bar_class():
     """The bar class, made on first use so that starting a command does not import
     tqdm (about 75 ms) when no long work comes."""
-    from tqdm import tqdm
+    from tqdm import tqdm  # deferred: every command loads this module, few draw a bar (75 ms)
 
     class Bar(tqdm):
         """A tqdm bar that, while drawn, sends rough's log lines through ``tqdm.write``,
@@ -97,7 +97,7 @@ def _bar_class():
             super().__init__(*args, **kwargs)
             logger = logging.getLogger("rough")
             if not self.disable and any(isinstance(h, logging.StreamHandler) for h in logger.handlers):
-                from tqdm.contrib.logging import logging_redirect_tqdm
+                from tqdm.contrib.logging import logging_redirect_tqdm  # deferred with tqdm
 
                 self._redirect = logging_redirect_tqdm([logger], tqdm_class=tqdm)
                 self._redirect.__enter__()

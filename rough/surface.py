@@ -13,8 +13,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+import rough  # the package: rough.io (which builds Surfaces) loads only when write() needs it
+
 from . import __version__
 from .errors import InputError
+from .units import digits_for, format_length
 
 MAX_POINTS = 1 << 28  # 16384 × 16384: 2 GiB of heights; `features` takes ~10× that (rough.io.limits)
 SPACING_RANGE = (1e-12, 1e6)  # metres: below atomic resolution or beyond a continent, a unit is wrong
@@ -37,8 +40,8 @@ class Units:
     """The units a surface's source file used for lateral and height values.
 
     Informational only: rough always holds metres, whatever the file used. Readers
-    record the units they found; writers that can carry them (X3P, TSV, GSF, EXR)
-    pass them on.
+    record the units they found; writers whose format carries them (``rough formats``
+    lists what each carries) pass them on.
 
     Attributes
     ----------
@@ -227,12 +230,11 @@ class Surface:
         return self.derive("crop", parameters, heights=self.heights[index], origin=tuple(origin))
 
     def write(self, target, format=None):
-        """Write to a path or binary stream, atomically for paths. ``format`` is one of
-        ``x3p``, ``exr``, ``gsf``, ``tsv``, ``npy``; by default it follows the file
-        extension, and a stream gets X3P."""
-        from .io import write
-
-        write(self, target, format=format)
+        """Write to a path or binary stream, atomically for paths, as
+        :func:`rough.io.write` does. ``format`` is a key of ``rough.io.WRITABLE`` (``rough
+        formats`` lists them); by default it follows the file extension, and a stream
+        gets X3P."""
+        rough.io.write(self, target, format=format)
 
     def __repr__(self):
         dims = " × ".join(str(n) for n in self.points)
@@ -299,8 +301,6 @@ def index_range(bound, origin, spacing, count, name):
     start = 0 if low is None else max(0, int(np.floor((low - origin) / spacing + 0.5)))
     stop = count if high is None else min(count, int(np.floor((high - origin) / spacing + 0.5)) + 1)
     if stop - start < 2:
-        from .units import digits_for, format_length
-
         last = origin + spacing * (count - 1)
         digits = digits_for(max(abs(origin), abs(last)), spacing)
         ends = ":".join("" if end is None else format_length(end, digits).replace(" ", "") for end in bound)

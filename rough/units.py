@@ -1,7 +1,10 @@
 """Lengths with units: parsing what people type and what files say, printing with a unit.
 
-Inside rough every length is in metres. On the command line a length takes a unit
-(``0.1545mm``, ``30.9um``, ``2e-3m``); a bare number is in millimetres.
+Inside rough every length is in metres. rough never guesses a unit: a number in a file
+that names none is in metres (SI) unless the reader is told otherwise, and a length,
+frequency or physical quantity typed on the command line names its unit (``0.1545mm``,
+``30.9um``, ``0.2/mm``, ``1.28N/mm``); zero needs none. (rough 0.12 still reads a bare
+number there in the option's old default unit, with a warning: :func:`is_bare`.)
 """
 
 import math
@@ -65,15 +68,39 @@ def metres_per(unit):
     return METRES_PER_UNIT[word]
 
 
-def parse_length(text, default_unit="mm"):
-    """``'30.9um'`` → 3.09e-05 (metres). A bare number is in ``default_unit``.
+def is_bare(text):
+    """Whether ``text`` is a number that names no unit (zero included).
+
+    >>> is_bare("0.8"), is_bare(" -2e-3 "), is_bare("0.8mm"), is_bare("0.2/mm"), is_bare("x")
+    (True, True, False, False, False)
+    """
+    match = _NUMBER_AND_UNIT.match(str(text))
+    return bool(match) and match.group(2) is None
+
+
+def _unit_named(match, text, default_unit, example):
+    """The unit ``match`` names, else ``default_unit``; a bare zero needs none (``'m'``)."""
+    unit = match.group(2) or default_unit
+    if unit is None:
+        if float(match.group(1)) != 0:
+            raise InputError(f"{text!r} names no unit (write e.g. {example})")
+        return "m"
+    return unit
+
+
+def parse_length(text, default_unit=None):
+    """``'30.9um'`` → 3.09e-05 (metres). A bare number is in ``default_unit``; with
+    none, only zero may be bare.
 
     Raises InputError for text that is not a finite number with a length unit.
+
+    >>> parse_length("30.9um"), parse_length("0"), parse_length("2", "mm")
+    (3.09e-05, 0.0, 0.002)
     """
     match = _NUMBER_AND_UNIT.match(str(text))
     if not match:
         raise InputError(f"{text!r} is not a length (write e.g. 0.1545mm, 30.9um, 2e-3m)")
-    value = float(match.group(1)) * metres_per(match.group(2) or default_unit)
+    value = float(match.group(1)) * metres_per(_unit_named(match, text, default_unit, "0.1545mm or 30.9um"))
     if not math.isfinite(value):
         raise InputError(f"{text!r} is not a finite length")
     return value
@@ -157,13 +184,13 @@ _FREQUENCY = re.compile(
 )
 
 
-def parse_frequency(text, default_unit="mm"):
+def parse_frequency(text, default_unit=None):
     """A spatial frequency in cycles per length: ``'0.2/mm'``, ``'200/m'``, ``'5 per um'``
-    → 1/m. A bare number is per ``default_unit``."""
+    → 1/m. A bare number is per ``default_unit``; with none, only zero may be bare."""
     match = _FREQUENCY.match(str(text))
     if not match:
         raise InputError(f"{text!r} is not a spatial frequency (write e.g. 0.2/mm or 200/m)")
-    value = float(match.group(1)) / metres_per(match.group(2) or default_unit)
+    value = float(match.group(1)) / metres_per(_unit_named(match, text, default_unit, "0.2/mm or 200/m"))
     if not math.isfinite(value) or value < 0:
         raise InputError(f"{text!r} is not a usable spatial frequency")
     return value
@@ -185,10 +212,12 @@ QUANTITIES = {
 def parse_quantity(text, kind, default_unit=None):
     """``parse_quantity('1.28N/mm', 'stiffness')`` → 1280.0 (SI). Units may be written
     with ``*``, ``·`` or a space for products (``N*s/m``, ``N·s/mm``) and ``µ``/``u``
-    for micro; a bare number is in ``default_unit`` (refused if None)."""
-    units = QUANTITIES[kind][1]
+    for micro; a bare number is in ``default_unit`` (with none, only zero may be bare)."""
+    si_unit, units = QUANTITIES[kind]
     match = _NUMBER_AND_UNIT.match(str(text).replace(" ", "").replace("·", "*"))
     unit = None if not match else (match.group(2) or default_unit)
+    if match and unit is None and float(match.group(1)) == 0:
+        unit = si_unit
     if unit is not None:
         unit = unit.replace("µ", "u").replace("μ", "u").replace("Ns", "N*s").replace("**", "^").replace("²", "^2")
     if unit not in units:

@@ -15,7 +15,7 @@ os.environ.setdefault("SOURCE_DATE_EPOCH", "1767225600")  # 2026-01-01
 
 import numpy as np
 
-from rough.fractal.synth import synthesize_map, synthesize_profile
+from rough.fractal import synthesize_map, synthesize_profile
 
 HERE = pathlib.Path(__file__).resolve().parent
 

@@ -1,14 +1,20 @@
 """Fixtures shared by the tests: the third-party data folder, running ``rough`` as a
 separate process exactly as a shell user would, and surfalize's seeded test data."""
 
+import atexit
 import os
 import pathlib
+import shutil
 import subprocess
 import sys
+import tempfile
 
 # what `import rough` sets when numpy is not loaded yet (docs/design.rst, "Threads"); test
 # modules import numpy first
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+# `rough --help` keeps its text in the user's cache (rough/cli/launch.py): the suite uses its own
+os.environ["XDG_CACHE_HOME"] = tempfile.mkdtemp(prefix="rough-tests-cache-")
+atexit.register(shutil.rmtree, os.environ["XDG_CACHE_HOME"], ignore_errors=True)
 
 import pytest  # noqa: E402
 from hypothesis import settings  # noqa: E402

@@ -54,7 +54,7 @@ def start_render(folder, device, *extra):
         "--device",
         device,
         "--rate",
-        "200",
+        "200Hz",
         "--ramp",
         "0",
         "--stick-span",

@@ -11,8 +11,8 @@ import pytest
 
 import rough
 from rough import Surface
+from rough.fractal.filling import fill_invalid
 from rough.fractal.fit import fit_fractal
-from rough.fractal.resample import fill_invalid
 from rough.fractal.scaling import TOLERANCE, departure, fit_spectrum, profile_bins
 
 from conftest import shared_data_path

@@ -92,7 +92,6 @@ def test_calibrated_whittle():
     """The Whittle entry, 80 profiles at each H (n = 1024) and Davies-Harte: the mean of
     80 corrected values has a standard error ≈ 0.003 (SD ≈ 0.025); 240 intervals give a
     binomial SD of 1.4 % at 95 % (90 % and 98 %: 3.6 and 2.1 SD)."""
-    pytest.importorskip("rough.fractal.profiles", reason="slice B's profiles.py (whittle_hurst) is not there yet")
     check_unbiased_and_covered(outcomes(davies_harte, 1024, 80, ["whittle"], 4)["whittle"])
 
 

@@ -1,18 +1,140 @@
-"""The HID backend's guard against a joystick that a kernel force-feedback driver holds
-(against a fake sysfs tree), and the stability warning as the command line gives it."""
+"""Every render backend keeps the contract of rough.render.device: its declared facts,
+its factory's signature, and (when it opens without hardware) the Device protocol
+through a short run of the servo loop. Parametrised over device.backends() at
+collection time, so an installed plugin (entry-point group rough.devices) is tested
+by name with no edit here. Then the HID backend's guard against a joystick that a
+kernel force-feedback driver holds (against a fake sysfs tree), and the stability
+warning as the command line gives it."""
 
+import inspect
+import logging
+import math
 import os
+import sys
+import types
 
 import numpy as np
 import pytest
 
 import rough
 import rough.extras
+from rough import RoughError
+from rough.render import QuasiStatic, Settings, Track, forces, run, simulate
+from rough.render import device as registry
+from rough.render.device import Backend, Capabilities, Device, Workspace
+from rough.render.hand import BACKEND as HAND
 from rough.render.hid import find_joystick, kernel_force_feedback
 from rough.render.pid import PidError
 
 from conftest import assert_one_line_error
 from conftest import rough as run_rough
+
+BACKENDS = registry.backends()
+TRACK = Track(np.zeros(101), 0.1e-3)  # 10 mm, flat
+SPACE = Workspace(0.0, TRACK.length, 0.0, 1e-3)
+MAX_FORCE = 2.0  # N
+FACTORY = ("argument", "workspace", "max_force")
+
+
+@pytest.mark.parametrize("name", list(BACKENDS))
+def test_a_backend_declares_its_facts(name):
+    backend = BACKENDS[name]
+    assert isinstance(backend, Backend) and backend.name == name
+    assert name and ":" not in name and name == name.strip()
+    assert isinstance(backend.title, str) and backend.title
+    assert backend.argument is None or (isinstance(backend.argument, str) and backend.argument.strip())
+    assert isinstance(backend.requires, tuple) and all(isinstance(module, str) for module in backend.requires)
+    assert isinstance(backend.simulated, bool)
+    assert backend.form in registry.forms() and f"{name}: {backend.title}" in registry.descriptions()
+
+
+@pytest.mark.parametrize("name", list(BACKENDS))
+def test_its_factory_takes_the_registry_arguments(name):
+    parameters = list(inspect.signature(registry.modules()[name].open_device).parameters.values())
+    assert tuple(parameter.name for parameter in parameters[:3]) == FACTORY
+    assert all(parameter.kind is inspect.Parameter.POSITIONAL_OR_KEYWORD for parameter in parameters[:3])
+    assert parameters[-1].kind is inspect.Parameter.VAR_KEYWORD
+
+
+@pytest.mark.parametrize("name", list(BACKENDS))
+def test_it_opens_and_keeps_the_device_protocol_or_says_why_in_one_line(name):
+    if BACKENDS[name].simulated:
+        options = dict(speed=0.02, start_x=0.0, start_y=-1.0 / QuasiStatic().stiffness, period=1e-3)
+        opened = registry.open_device(name, SPACE, MAX_FORCE, **options)
+    else:
+        try:
+            opened = registry.open_device(name, SPACE, MAX_FORCE)
+        except RoughError as error:  # no such hardware here, or its extra is not installed
+            assert str(error) and "\n" not in str(error)
+            return
+    assert isinstance(opened, Device) and isinstance(opened.label, str)
+    capabilities = opened.capabilities
+    assert isinstance(capabilities, Capabilities) and capabilities.axes in (1, 2)
+    assert capabilities.rate is None or capabilities.rate > 0
+    assert capabilities.damping >= 0
+    vx, vy = opened.velocity
+    x, y, buttons = opened.read()
+    assert all(math.isfinite(value) for value in (vx, vy, x, y)) and isinstance(buttons, int)
+    if not capabilities.simulated:  # a real device: opened and closed, no force written
+        opened.close()
+        opened.close()
+        return
+    result = run(opened, [TRACK], QuasiStatic(), None, Settings(realtime=False, duration=0.05))
+    assert result.ticks == 50 and result.ended_by == "duration"
+    assert np.isfinite(result.trace["F_y"]).all() and np.isfinite(result.trace["F_x"]).all()
+    opened.close()  # a second close is safe
+
+
+def test_the_simulated_hand_renders_a_short_run():
+    result = simulate(TRACK, speed=0.1)  # 0.1 s over the flat track
+    assert result.ticks == 100 and result.settings.duration == pytest.approx(0.1)
+    assert round(forces(result)["F_y_mean"], 9) == 1.0 and registry.is_simulated(HAND.name)
+
+
+def test_an_unknown_device_names_every_backend():
+    with pytest.raises(registry.DeviceError) as caught:
+        registry.parse_device("no-such-device")
+    for name, backend in BACKENDS.items():
+        assert name in str(caught.value)
+        assert backend.argument is None or f"{name}:{backend.argument}" in str(caught.value)
+
+
+@pytest.fixture
+def plugins(monkeypatch):
+    """Install entry points ``{name: module}`` for the registry, afresh."""
+
+    def install(points, modules=()):
+        for module in modules:
+            monkeypatch.setitem(sys.modules, module.__name__, module)
+        monkeypatch.setattr(registry, "entry_points", lambda group: dict(points))
+        registry.modules.cache_clear()
+
+    yield install
+    registry.modules.cache_clear()
+
+
+def toy_module(module_name, name):
+    toy = types.ModuleType(module_name)
+    toy.BACKEND = Backend(name=name, title="a toy")
+    toy.open_device = lambda argument, workspace, max_force, **options: None
+    return toy
+
+
+def test_a_plugin_joins_after_the_built_in_backends_which_win_over_it(plugins):
+    plugins({"sim": "toy_sim", "toy": "toy_device"}, [toy_module("toy_sim", "sim"), toy_module("toy_device", "toy")])
+    known = registry.backends()
+    assert list(known)[-1] == "toy" and known["sim"].title == BACKENDS["sim"].title
+    assert registry.forms().endswith(" or toy")
+
+
+def test_a_broken_plugin_is_left_out_with_one_warning_line(plugins, caplog):
+    plugins({"gone": "no_such_rough_device_module", "bare": "bare_device"}, [types.ModuleType("bare_device")])
+    with caplog.at_level(logging.WARNING, logger="rough"):
+        known = registry.backends()
+    assert "gone" not in known and "bare" not in known
+    warnings = [record.getMessage() for record in caplog.records]
+    assert len(warnings) == 2 and all("\n" not in warning for warning in warnings)
+    assert "'gone' (no_such_rough_device_module) is left out" in warnings[0]
 
 
 def fake_sysfs(root, ff_bits, driver="hid-generic"):

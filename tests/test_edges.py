@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from rough import Surface
-from rough.fractal import synth
+from rough.fractal import synth, synth_map
 from rough.io import read
 
 from conftest import assert_one_line_error, rough
@@ -24,7 +24,7 @@ def fractal_profile(points, spacing, rq):
 
 
 def fractal_map(size, spacing, rq):
-    return synth.synthesize_map((size, size), (spacing, spacing), 2.4, rq=rq, seed=5).heights
+    return synth_map.synthesize_map((size, size), (spacing, spacing), 2.4, rq=rq, seed=5).heights
 
 
 def sine(points, cycles, amplitude, offset=0.0):
@@ -133,7 +133,7 @@ def test_a_constant_surface_has_zero_height_parameters_and_undefined_shape_ones(
 def test_derived_surfaces_stay_finite(files, tmp_path, name):
     """detrend, resample and the tip keep every point of a gap-free surface defined."""
     spacing = read(files[name]).spacing[0]
-    for command in (["detrend"], ["resample", "--spacing", f"{2 * spacing}m"], ["detrend", "--tip", f"{3 * spacing}m"]):
+    for command in (["detrend"], ["resample", "--step", f"{2 * spacing}m"], ["detrend", "--tip", f"{3 * spacing}m"]):
         target = tmp_path / "out.x3p"
         result = rough(*command, files[name], "-o", target)
         assert result.returncode == 0, result.stderr.decode()

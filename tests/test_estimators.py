@@ -10,6 +10,7 @@ from hypothesis import strategies as st
 
 from rough.errors import InputError
 from rough.fractal import estimators as est
+from rough.fractal.pooled import whittle_hurst
 
 from conftest import shared_data_path
 from fbm import fbm
@@ -198,11 +199,10 @@ def test_the_order_of_the_profiles_does_not_matter(seed, name):
 
 
 def test_whittle_entry_calls_the_pooled_whittle_fit():
-    profiles_module = pytest.importorskip("rough.fractal.profiles", reason="slice B's profiles.py is not there yet")
     rng = np.random.default_rng(3)
     profiles = [fbm(1024, 0.5, rng) for _ in range(4)]
     estimate = est.ESTIMATORS["whittle"](profiles, 1e-3)
-    assert estimate.hurst == profiles_module.whittle_hurst(profiles, 1e-3)
+    assert estimate.hurst == whittle_hurst(profiles, 1e-3)
     assert estimate.points == 4 * 512
     assert estimate.scales == (2e-3, 1.024)
     assert est.whittle(profiles, 1e-3, scales=(0.01, 0.1)).points == 4 * sum(

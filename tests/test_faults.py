@@ -12,7 +12,7 @@ import pytest
 
 from conftest import assert_one_line_error, rough
 
-BIG = ["synth", "--size", "4096x4096", "--spacing", "1um", "--dimension", "2.3", "--amplitude", "1um", "--seed", "1"]
+BIG = ["synth", "--size", "4096x4096", "--step", "1um", "--dimension", "2.3", "--amplitude", "1um", "--seed", "1"]
 
 
 def start_writing(folder):
@@ -99,7 +99,7 @@ def test_a_full_disk_is_a_clear_error_and_leaves_nothing(tiny_disk):
         "synth",
         "--size",
         "256x256",
-        "--spacing",
+        "--step",
         "1um",
         "--dimension",
         "2.3",

@@ -261,7 +261,7 @@ def test_third_party_text_files(shared_data, name, points, size):
 
 
 def test_matrix3_and_matrix4_heights(shared_data):
-    from rough.summary import summary
+    from rough.metrology import summary
 
     assert summary(read(shared_data / "SurfaceTopography/matrix-3.txt"))["Sq"] == pytest.approx(
         3.5222918750198742e-08, rel=1e-12
@@ -272,7 +272,7 @@ def test_matrix3_and_matrix4_heights(shared_data):
 
 
 def test_hfm_line_scan_rms(shared_data):
-    from rough.summary import summary
+    from rough.metrology import summary
 
     assert summary(read(shared_data / "SurfaceTopography/hfm-1.hfm"))["Rq"] == pytest.approx(0.000905688e-3, rel=1e-6)
 

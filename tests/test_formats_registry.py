@@ -2,12 +2,15 @@
 ``rough formats``, the docs and the error messages come; every third-party example file
 recognised as its format; the error-path files refused in one line."""
 
+import importlib
 import io
 import json
+import sys
 
 import click
 import numpy as np
 import pytest
+from plugin_package import install_plugin
 
 from rough import Surface
 from rough.errors import FormatError, InputError
@@ -200,10 +203,13 @@ def test_regrid_applies_to_uneven_text_and_is_recorded():
     assert surface.history[-1]["command"] == "regrid"
 
 
-def test_the_docs_list_every_format():
+def test_the_docs_have_a_section_for_every_built_in_format():
     page = (ROOT / "docs" / "formats.rst").read_text()
-    for name in FORMATS:
-        assert f"``{name}``" in page, name
+    for module_name in registry.MODULES + registry.FALLBACKS:
+        facts = registry.module(module_name).FORMAT
+        assert f"{facts.title} (``{facts.name}``)" in page and f"automodule:: rough.io.{module_name}" in page, (
+            facts.name
+        )
 
 
 @pytest.mark.parametrize(
@@ -222,8 +228,9 @@ def test_the_cli_regrid_option_takes_a_length_and_a_method(run):
     uneven = b"x z\n0 0\n1 1\n3 3\n4 4\n"
     facts = json.loads(run("info", "--json", "--regrid", "0.5m:linear", input=uneven, check=True).stdout)
     assert facts["shape"] == [9] and facts["spacing"] == [0.5]
-    facts = json.loads(run("info", "--json", "--regrid", "250", input=uneven, check=True).stdout)
-    assert facts["spacing"] == [0.25]  # a bare number is in mm
+    bare = run("info", "--json", "--regrid", "250", input=uneven, check=True)
+    assert json.loads(bare.stdout)["spacing"] == [0.25]  # a bare number is still mm in 0.12, with a warning
+    assert b"a bare number is read as 250 mm" in bare.stderr
     assert_one_line_error(run("info", "--regrid", "1um:cubic", input=uneven), "linear or bandlimited")
 
 
@@ -246,3 +253,126 @@ def test_every_shared_file_reads_or_is_refused_with_an_input_error(name):
         assert "\n" not in str(error) and str(error).startswith(str(path))
         return
     assert surface.heights.ndim in (1, 2) and surface.heights.dtype.kind == "f"
+
+
+# A format plugin as a package lays it out: the module of docs/design.rst's "add a format".
+TOY_FORMAT = '''"""Toy: a tiny text format, heights one row a line after a line of spacing and one of origin."""
+
+import numpy as np
+
+from rough import Surface
+from rough.io.registry import Format
+
+FORMAT = Format("toy", "Toy text grid", (".toy",), magic=(b"TOY1\\n",), writes=True, carries=("spacing",), binary=False)
+
+
+def read(data, options):
+    _, spacing, origin, *rows = bytes(data).decode("ascii").splitlines()
+    spacing, origin = (tuple(map(float, line.split())) for line in (spacing, origin))
+    heights = np.array([[float(value) for value in row.split()] for row in rows])
+    return Surface(heights[0] if len(spacing) == 1 else heights, spacing, origin)
+
+
+def write(surface, stream):
+    lines = ["TOY1", *(" ".join(map(repr, values)) for values in (surface.spacing, surface.origin))]
+    lines += [" ".join(map(repr, row.tolist())) for row in np.atleast_2d(surface.heights)]
+    stream.write(("\\n".join(lines) + "\\n").encode("ascii"))
+'''
+
+
+@pytest.fixture
+def plugins(monkeypatch, tmp_path):
+    """Install plugin modules in this process: ``plugins({entry name: module text})``;
+    the registry is read afresh, and again after the test."""
+
+    def install(modules):
+        for index, (point, text) in enumerate(modules.items()):
+            (tmp_path / f"plugin_{index}.py").write_text(text)
+        points = {point: f"plugin_{index}" for index, point in enumerate(modules)}
+        for name in points.values():
+            monkeypatch.delitem(sys.modules, name, raising=False)
+        importlib.invalidate_caches()
+        monkeypatch.setattr(registry, "entry_points", lambda group: points if group == "rough.formats" else {})
+        registry._modules.cache_clear()
+        registry.formats.cache_clear()
+
+    monkeypatch.syspath_prepend(str(tmp_path))
+    yield install
+    monkeypatch.undo()
+    registry._modules.cache_clear()
+    registry.formats.cache_clear()
+
+
+def test_a_plugin_format_is_sniffed_after_the_built_ins_and_before_text(plugins):
+    plugins({"toy": TOY_FORMAT})
+    order = list(registry.formats())
+    assert order[-2:] == ["toy", "tsv"]
+    assert order[:-2] == [registry.module(name).FORMAT.name for name in registry.MODULES]
+    text = b"TOY1\n1e-06 2e-06\n0.0 0.5\n1.0 2.0\n3.0 nan\n"
+    assert registry.sniff(text) == "toy"
+    surface = read_bytes(text)
+    assert surface.source_format == "toy" and surface.spacing == (1e-6, 2e-6) and surface.origin == (0.0, 0.5)
+    assert np.array_equal(surface.heights, [[1.0, 2.0], [3.0, np.nan]], equal_nan=True)
+    buffer = io.BytesIO()
+    surface.write(buffer, "toy")
+    assert buffer.getvalue() == text
+    assert "toy" in registry.writable() and registry.extensions()[".toy"] == "toy"
+
+
+@pytest.mark.parametrize(
+    "module, warning",
+    [
+        ("raise ImportError('no module toy_dependency')", "format plugin broken (plugin_0) left out: ImportError"),
+        ("FORMAT = None", "format plugin broken (plugin_0) left out: it declares no FORMAT"),
+        (TOY_FORMAT.replace('Format("toy"', 'Format("x3p"'), "format plugin broken (plugin_0) left out: rough has"),
+    ],
+)
+def test_a_broken_or_clashing_plugin_is_left_out_with_one_line(plugins, caplog, module, warning):
+    plugins({"broken": module})
+    with caplog.at_level("WARNING", logger="rough"):
+        table = registry.formats()
+    assert "toy" not in table and table["x3p"].title == "X3P (ISO 25178-72)"
+    assert [record.getMessage().splitlines() for record in caplog.records] == [[caplog.records[0].getMessage()]]
+    assert caplog.records[0].getMessage().startswith(warning)
+
+
+def test_of_two_plugins_with_one_name_the_first_is_kept_and_the_second_named(plugins, caplog):
+    plugins({"first": TOY_FORMAT, "second": TOY_FORMAT})
+    with caplog.at_level("WARNING", logger="rough"):
+        assert "toy" in registry.formats()
+    assert [record.getMessage() for record in caplog.records] == [
+        "format plugin second (plugin_1) left out: an earlier plugin has a format named 'toy'"
+    ]
+
+
+# A vendor format inside a container rough reads (Zygo DATX is HDF5): only a plugin reads it.
+DATX = TOY_FORMAT.replace(
+    'Format("toy", "Toy text grid", (".toy",), magic=(b"TOY1\\n",),',
+    'Format("datx", "Zygo DATX (a plugin)", (".datx",), magic=(b"\\x89HDF\\r\\n\\x1a\\n",),',
+)
+
+
+def test_a_plugin_reads_a_vendor_format_inside_a_container_rough_reads(plugins):
+    head = b"\x89HDF\r\n\x1a\n" + bytes(100)
+    with pytest.raises(FormatError, match="Zygo DATX .* is not a format rough reads yet"):
+        registry.sniff(head, "scan.datx")
+    plugins({"datx": DATX})
+    assert registry.sniff(head, "scan.datx") == "datx"
+    assert registry.sniff(head, "scan.h5") == "hdf5"
+
+
+def test_a_kelvin_probe_surface_potential_is_not_a_height():
+    names = ["Surface potential", "SurfacePotential", "surface_potential", "Surface", "surface height", "Z_grid"]
+    assert [registry.names_height(name) for name in names] == [False, False, False, True, True, True]
+
+
+def test_an_installed_plugin_appears_in_rough_formats_and_reads(run, tmp_path):
+    env = install_plugin(tmp_path, {"toy_format.py": TOY_FORMAT}, "[rough.formats]\ntoy = toy_rough.toy_format\n")
+    listing = json.loads(run("formats", "--json", env=env, check=True).stdout)["formats"]
+    assert {"name": "toy", "write": True, "extensions": [".toy"]}.items() <= next(
+        row for row in listing if row["name"] == "toy"
+    ).items()
+    scan = tmp_path / "scan.toy"
+    scan.write_bytes(b"TOY1\n1e-06\n0.0\n1.0 2.0 4.0\n")
+    info = json.loads(run("info", "--json", scan, env=env, check=True).stdout)
+    assert "toy" in json.dumps(info).lower()

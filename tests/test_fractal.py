@@ -9,10 +9,9 @@ from scipy.special import zeta
 
 from rough import Surface
 from rough.errors import InputError
-from rough.fractal import model, psd
-from rough.fractal.fit import fit_fractal
-from rough.fractal.resample import resample
-from rough.fractal.synth import synthesize_fragments, synthesize_map, synthesize_profile
+from rough.fractal import model, psd, synthesize_fragments, synthesize_map, synthesize_profile
+from rough.fractal.fit import METHODS, fit_fractal
+from rough.fractal.resampling import resample
 
 from fbm import fbm
 
@@ -322,3 +321,35 @@ def test_gaps_must_be_filled_before_a_spectrum():
     heights[5] = np.nan
     with pytest.raises(InputError, match="--fill"):
         fit_fractal(Surface(heights, (1e-6,)))
+
+
+# -- the package: its registries and its stub -----------------------------------------------
+
+
+def test_the_methods_are_whittle_and_the_registered_cross_checks():
+    from rough.fractal.cross_checks import CROSS_CHECKS
+    from rough.fractal.fit import METHODS
+
+    assert METHODS == ("whittle", *CROSS_CHECKS)
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_every_method_fits_a_profile_and_names_itself(method):
+    from rough.fractal.fit import METHODS
+
+    assert method in METHODS
+    fit = fit_fractal(synthesize_profile(2048, 1e-6, 1.4, rq=1e-6, seed=3), method=method)
+    assert fit.method.startswith(method) and 1.2 < fit.fractal_dimension < 1.6
+
+
+def test_the_stub_names_what_the_package_offers_and_no_module_shadows_a_name():
+    import pathlib
+
+    import rough.fractal
+
+    modules = {path.stem for path in pathlib.Path(rough.fractal.__file__).parent.glob("*.py")}
+    assert not modules & set(rough.fractal.__all__)  # importing a module would overwrite the name
+    for name in rough.fractal.__all__:
+        assert getattr(rough.fractal, name) is not None
+    assert rough.fractal.fit_fractal.__module__ == "rough.fractal.fit"
+    assert rough.fractal.rose.__module__ == "rough.fractal.sectors"

@@ -44,7 +44,7 @@ def test_synth_map_then_fit_reports_the_surface_dimension():
         "synth",
         "--size",
         "256x256",
-        "--spacing",
+        "--step",
         "10um",
         "--dimension",
         "2.3",
@@ -86,7 +86,7 @@ def test_anisotropic_map_from_the_command_line():
         "synth",
         "--size",
         "256x256",
-        "--spacing",
+        "--step",
         "10um",
         "--anisotropy",
         "2.2,1um,2.5,3um,30",
@@ -142,7 +142,7 @@ def test_resample_command():
         "synth",
         "--length",
         "10mm",
-        "--spacing",
+        "--step",
         "0.0309mm",
         "--dimension",
         "1.3",
@@ -152,7 +152,7 @@ def test_resample_command():
         "1",
         check=True,
     ).stdout
-    coarse = rough("resample", "--spacing", "0.1545mm", input=surface, check=True).stdout
+    coarse = rough("resample", "--step", "0.1545mm", input=surface, check=True).stdout
     facts = json.loads(rough("info", "--json", input=coarse, check=True).stdout)
     assert facts["spacing"] == [pytest.approx(0.1545e-3)]
     assert [entry["command"] for entry in facts["history"]] == ["synth", "resample"]

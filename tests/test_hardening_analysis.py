@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from rough import Surface
-from rough.fractal.fit import FractalFit, announce
+from rough.fractal.result import FractalFit, announce
 from rough.metrology import parameters
 
 from conftest import assert_one_line_error

@@ -267,7 +267,7 @@ def test_ctrl_c_after_the_rename_counts_the_answer_saved(fresh, monkeypatch):
         if len(pathlib.Path(path).read_text().splitlines()) == 4:
             raise KeyboardInterrupt
 
-    monkeypatch.setattr(atomic, "atomic_output", then_interrupted)
+    monkeypatch.setattr(session, "atomic_output", then_interrupted)
     progress = session.run_session(fresh, "S01", answer_first, "script")
     assert (progress.answered, progress.remaining, progress.interrupted) == (3, 5, True)
     assert [int(row["trial"]) for row in session.read_answers(fresh, "S01")] == [1, 2, 3]

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import rough as library
-from rough.fractal.synth import synthesize_map
+from rough.fractal.synth_map import synthesize_map
 
 from conftest import assert_one_line_error, rough
 from fbm import fbm
@@ -16,10 +16,11 @@ ESTIMATOR_NAMES = ["whittle", "variogram", "dfa", "wavelet", "higuchi"]
 
 
 def test_the_command_line_offers_every_registered_estimator():
-    from rough.cli.fit_fractal import ESTIMATOR_NAMES as OFFERED
-    from rough.fractal.estimators import ESTIMATORS
+    from rough.cli.fit_fractal import fit_fractal
+    from rough.fractal import ESTIMATORS
 
-    assert list(OFFERED) == list(ESTIMATORS) == ESTIMATOR_NAMES
+    offered = next(param for param in fit_fractal.params if param.name == "estimator").type.choices
+    assert list(offered) == [*ESTIMATORS, "all"] == [*ESTIMATOR_NAMES, "all"]
 
 
 def fit_json(*args, input=None):
@@ -75,11 +76,11 @@ def test_rose_with_profiles_names_both_roses(tmp_path):
     surface = synthesize_map((128, 128), (1e-6, 1e-6), 2.4, amplitude=1e-7, seed=8)
     path = tmp_path / "map.x3p"
     library.write(surface, path)
-    values = json.loads(rough("rose", "--json", "--step", "45", "--profiles", path, check=True).stdout)
+    values = json.loads(rough("rose", "--json", "--angle-step", "45", "--profiles", path, check=True).stdout)
     assert values["kind"] == "sectors" and values["profiles"]["kind"] == "profiles"
     angles = [record["angle"] for record in values["profiles"]["directions"]]
     assert angles == [0.0, 45.0, 90.0, 135.0]
-    text = rough("rose", "--step", "45", "--profiles", path, check=True).stdout.decode()
+    text = rough("rose", "--angle-step", "45", "--profiles", path, check=True).stdout.decode()
     assert "profiles along θ" in text
 
 

@@ -14,7 +14,8 @@ from hypothesis import strategies as st
 import rough
 from rough.errors import InputError
 from rough.metrology import areal_parameters, feature_parameters, parameters, profile_parameters
-from rough.metrology.parameters import autocorrelation, sampling_sections, texture_direction
+from rough.metrology.profile import sampling_sections
+from rough.metrology.spatial import autocorrelation, texture_direction
 
 from conftest import assert_one_line_error
 from conftest import rough as run

@@ -12,7 +12,7 @@ from scipy.stats import norm
 
 from rough import InputError, Surface
 from rough.metrology import AREAL_FUNCTIONAL, PROFILE_FUNCTIONAL, MaterialRatioCurve, functional_parameters
-from rough.metrology.parameters import ROUNDING
+from rough.metrology.heights import ROUNDING
 
 from conftest import surfalize_heights
 from test_permutation import assert_same_core, length_tolerance, same_central_region

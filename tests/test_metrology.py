@@ -264,7 +264,7 @@ def test_map_dropouts_give_the_parameters_of_the_valid_points():
     seed=st.integers(0, 2**16),
 )
 def test_autocorrelation_is_the_mean_product_over_pairs_of_valid_points(rows, columns, fraction, seed):
-    from rough.metrology.parameters import autocorrelation
+    from rough.metrology.spatial import autocorrelation
 
     rng = np.random.default_rng(seed)
     heights = rng.normal(size=(rows, columns))
@@ -284,7 +284,7 @@ def test_autocorrelation_is_the_mean_product_over_pairs_of_valid_points(rows, co
 
 @pytest.mark.parametrize("slope", ["2point", "7point"])
 def test_gradients_of_a_gappy_map_with_unequal_sides(slope):
-    from rough.metrology.parameters import SEVEN_POINT
+    from rough.metrology.heights import SEVEN_POINT
 
     rng = np.random.default_rng(3)
     heights = rng.normal(size=(37, 90)) * 1e-6

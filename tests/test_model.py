@@ -19,7 +19,7 @@ from rough.units import format_length, metres_per, parse_length
         ("30.9 µm", 30.9e-6),
         ("30.9μm", 30.9e-6),
         ("2e-3m", 2e-3),
-        ("80", 80e-3),
+        ("0", 0.0),
         ("1.5nm", 1.5e-9),
         ("3km", 3e3),
         ("-2mm", -2e-3),
@@ -30,7 +30,7 @@ def test_parse_length(text, metres):
     assert parse_length(text) == pytest.approx(metres, rel=1e-15)
 
 
-@pytest.mark.parametrize("text", ["", "mm", "fast", "1.5 parsecs", "1e999m", "nan mm", "1..2mm"])
+@pytest.mark.parametrize("text", ["", "mm", "fast", "1.5 parsecs", "1e999m", "nan mm", "1..2mm", "80"])
 def test_parse_length_refuses(text):
     with pytest.raises(InputError):
         parse_length(text)

@@ -86,7 +86,7 @@ def test_every_numeric_type_is_one_that_refuses_nan():
 def inputs(tmp_path_factory):
     folder = tmp_path_factory.mktemp("ranges")
     made = {name: folder / name for name in ("map.x3p", "profile.x3p", "study", "answered")}
-    synthesis = ["--dimension", "2.3", "--rq", "1um", "--seed", "1", "--spacing", "2um"]
+    synthesis = ["--dimension", "2.3", "--rq", "1um", "--seed", "1", "--step", "2um"]
     rough("synth", "--size", "64x48", *synthesis, "-o", made["map.x3p"], check=True)
     rough("synth", "--points", "400", *synthesis[2:], "--dimension", "1.3", "-o", made["profile.x3p"], check=True)
     for study in ("study", "answered"):
@@ -106,10 +106,10 @@ BASES = {
     ("features",): ["{map}", "--json"],
     ("fit-fractal",): ["{map}", "--json"],
     ("info",): ["{map}", "--json"],
-    ("resample",): ["{map}", "--spacing", "4um", "-o", "{out}"],
+    ("resample",): ["{map}", "--step", "4um", "-o", "{out}"],
     ("rose",): ["{map}", "--json"],
     ("render",): ["{map}", "--duration", "20ms", "--json"],
-    ("synth",): ["--size", "32x32", "--spacing", "2um", "--dimension", "2.3", "--rq", "1um", "-o", "{out}"],
+    ("synth",): ["--size", "32x32", "--step", "2um", "--dimension", "2.3", "--rq", "1um", "-o", "{out}"],
     ("experiment", "design"): ["{folder}", "--reference", "1.275,0.2781mm", "--subjects", "1", "--seed", "1"],
     ("experiment", "run"): ["{study}", "--subject", "S01", "--observer", OBSERVER, "--stroke", "0.2s"],
     ("experiment", "analyze"): ["{answered}"],
@@ -126,9 +126,9 @@ OWN_BASES = {  # options that change which arguments make a valid call
     ("synth", "--length"): SYNTH_PROFILE,
     ("synth", "--points"): SYNTH_PROFILE,
     ("synth", "--fragments"): ["--points", "256", *SYNTH_PROFILE],
-    ("synth", "--size"): ["--spacing", "2um", "--dimension", "2.3", "--rq", "1um", "-o", "{out}"],
-    ("synth", "--amplitude"): ["--size", "32x32", "--spacing", "2um", "--dimension", "2.3", "-o", "{out}"],
-    ("synth", "--anisotropy"): ["--size", "32x32", "--spacing", "2um", "-o", "{out}"],
+    ("synth", "--size"): ["--step", "2um", "--dimension", "2.3", "--rq", "1um", "-o", "{out}"],
+    ("synth", "--amplitude"): ["--size", "32x32", "--step", "2um", "--dimension", "2.3", "-o", "{out}"],
+    ("synth", "--anisotropy"): ["--size", "32x32", "--step", "2um", "-o", "{out}"],
 }
 
 
@@ -231,15 +231,15 @@ def test_the_spacing_options_take_what_a_surface_takes():
 @pytest.mark.parametrize(
     "args, said",
     [
-        (["detrend", "--tip", "1e308", "{map}"], "'1e308': a tip radius must lie between 1 pm and 10000 km"),
-        (["synth", "--length", "1e308", "--dimension", "1.3", "--rq", "1um"], "'1e308': a length must lie between"),
-        (["synth", "--size", "8x8", "--spacing", "1e-320", "--dimension", "2.3", "--rq", "1um"], "'1e-320': a length"),
-        (["rose", "--resolution", "1e-320", "{map}"], "'1e-320': a length must lie between 1 pm and 10000 km"),
-        (["render", "--rate", "1e-320", "{map}"], "'1e-320': a rate must lie between 0.001 Hz and 100000 Hz"),
-        (["render", "--mass", "1e-320", "{map}"], "'1e-320': a mass must lie between"),
-        (["experiment", "run", "--rate", "1e-320", "--subject", "S01", "{study}"], "'1e-320': a rate must lie"),
+        (["detrend", "--tip", "1e308m", "{map}"], "'1e308m': a tip radius must lie between 1 pm and 10000 km"),
+        (["synth", "--length", "1e308m", "--dimension", "1.3", "--rq", "1um"], "'1e308m': a length must lie between"),
+        (["synth", "--size", "8x8", "--step", "1e-320m", "--dimension", "2.3", "--rq", "1um"], "'1e-320m': a length"),
+        (["rose", "--resolution", "1e-320m", "{map}"], "'1e-320m': a length must lie between 1 pm and 10000 km"),
+        (["render", "--rate", "1e-320Hz", "{map}"], "'1e-320Hz': a rate must lie between 0.001 Hz and 100000 Hz"),
+        (["render", "--mass", "1e-320g", "{map}"], "'1e-320g': a mass must lie between"),
+        (["experiment", "run", "--rate", "1e-320Hz", "--subject", "S01", "{study}"], "'1e-320Hz': a rate must lie"),
         (["rose", "--level", "nan", "{map}"], "'nan' is not a finite number"),
-        (["synth", "--size", "8x8", "--dimension", "2.3", "--rq", "1e308"], "'1e308': a length must lie between"),
+        (["synth", "--size", "8x8", "--dimension", "2.3", "--rq", "1e308m"], "'1e308m': a length must lie between"),
     ],
 )
 def test_the_values_reported_in_issue_31_are_refused_in_one_line(inputs, args, said, tmp_path):

@@ -29,7 +29,7 @@ import numpy as np
 import pytest
 
 import rough
-from rough.fractal.synth import synthesize_map
+from rough.fractal.synth_map import synthesize_map
 
 from conftest import shared_data_path
 
@@ -494,7 +494,7 @@ def test_a_dem_is_drawn_north_up(tmp_path):
 def test_the_drawing_shows_the_lay_the_rose_finds_on_a_dem(tmp_path):
     """Ridges running south-west to north-east (lay 45°, counter-clockwise from east): the rose finds 45°, and on
     the drawn page the grey level changes less along 45° than across it."""
-    from rough.fractal.rose import rose
+    from rough.fractal.sectors import rose
 
     spec = (2.3, 1e-6, 2.3, 8e-6, math.radians(45.0))  # 8 times rougher across the ridges than along
     ridges = synthesize_map((256, 256), (1e-6, 1e-6), None, seed=45, anisotropy=spec).heights * 1e6  # 1 m spacing

@@ -67,7 +67,7 @@ def test_the_wheel_names_its_own_distribution_and_the_rough_command(wheel):
         licence = [name for name in archive.namelist() if name.endswith("LICENSE")]
     assert metadata["Name"] == DISTRIBUTION
     assert metadata["Version"] == rough.__version__
-    assert re.search(r"^rough = rough\.cli:main$", entry_points, re.MULTILINE)
+    assert re.search(r"^rough = rough\.cli\.launch:main$", entry_points, re.MULTILINE)
     assert licence, "LICENSE is not in the wheel"
     core = [r for r in metadata.get_all("Requires-Dist") if "extra ==" not in r]
     assert not any(name in " ".join(core) for name in ("matplotlib", "hidapi", "statsmodels")), core

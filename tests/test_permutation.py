@@ -37,7 +37,7 @@ from rough.metrology import (
     functional_parameters,
     profile_parameters,
 )
-from rough.metrology.parameters import ROUNDING
+from rough.metrology.heights import ROUNDING
 
 EXAMPLES = settings(max_examples=max(1000, settings.default.max_examples), deadline=None)
 EPS = np.finfo(float).eps

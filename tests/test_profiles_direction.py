@@ -3,7 +3,6 @@ rotation of the sampling lines, bilinear heights), their pooled Whittle fit, the
 jackknife over blocks of neighbouring profiles, the profile rose, and the Corona
 Heights fault's H along and across slip."""
 
-import importlib.util
 import math
 
 import numpy as np
@@ -13,15 +12,11 @@ from hypothesis import strategies as st
 from scipy.optimize import minimize_scalar
 
 import rough
-from rough.fractal.profiles import (
-    ProfileSet,
-    _rotated_lines,
-    fit_profiles,
-    profile_rose,
-    take_profiles,
-    whittle_hurst,
-)
-from rough.fractal.synth import synthesize_map
+from rough.fractal.pooled import whittle_hurst
+from rough.fractal.profile_set import ProfileSet, _rotated_lines, take_profiles
+from rough.fractal.profiles import fit_profiles, profile_rose
+from rough.fractal.scales import reliability_cutoff
+from rough.fractal.synth_map import synthesize_map
 
 from conftest import shared_data_path
 from fbm import fbm
@@ -336,12 +331,7 @@ def test_the_result_names_what_it_is_and_merges_the_fit():
     assert values["fractal_dimension_stderr"] == values["hurst_stderr"] and values["design_effect"] >= 1
 
 
-@pytest.mark.skipif(
-    importlib.util.find_spec("rough.fractal.scales") is None, reason="rough.fractal.scales not there yet"
-)
 def test_a_tip_radius_stops_the_band_at_its_reliability_cutoff():
-    from rough.fractal.scales import reliability_cutoff
-
     taken = take_profiles(rough.Surface(ROWS, 1e-6), "x")
     radius = 1e-7
     cutoff = reliability_cutoff(taken.heights, taken.spacing, radius)

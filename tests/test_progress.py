@@ -38,7 +38,7 @@ def progress_enabled():
 def big_map(tmp_path_factory):
     """2.048 mm × 2.048 mm at 2 µm: a 0.5 mm tip takes seconds here."""
     path = tmp_path_factory.mktemp("maps") / "big.x3p"
-    command = ("synth", "--size", "1024x1024", "--spacing", "2um", "--dimension", "2.3", "--rq", "20um")
+    command = ("synth", "--size", "1024x1024", "--step", "2um", "--dimension", "2.3", "--rq", "20um")
     rough(*command, "--seed", "5", "-o", path, check=True, env=ENV)
     return path
 
@@ -47,7 +47,7 @@ def big_map(tmp_path_factory):
 def medium_map(tmp_path_factory):
     """1.024 mm × 1.024 mm at 2 µm: a 0.25 mm tip takes a fraction of a second."""
     path = tmp_path_factory.mktemp("maps") / "medium.x3p"
-    command = ("synth", "--size", "512x512", "--spacing", "2um", "--dimension", "2.3", "--rq", "20um")
+    command = ("synth", "--size", "512x512", "--step", "2um", "--dimension", "2.3", "--rq", "20um")
     rough(*command, "--seed", "6", "-o", path, check=True, env=ENV)
     return path
 
@@ -222,7 +222,7 @@ def test_a_warning_during_the_work_gets_its_own_line_and_the_bar_comes_back(monk
 
 def test_a_tip_wider_than_a_map_is_refused_when_the_pass_would_be_long(tmp_path):
     wide = tmp_path / "wide.x3p"
-    command = ("synth", "--size", "4096x2048", "--spacing", "1um", "--dimension", "2.3", "--rq", "20um")
+    command = ("synth", "--size", "4096x2048", "--step", "1um", "--dimension", "2.3", "--rq", "20um")
     rough(*command, "--seed", "7", "-o", wide, check=True, env=ENV)
     out = tmp_path / "finger.x3p"
     result = rough("detrend", "--tip", "fingertip", wide, "-o", out, env=ENV, timeout=120)
@@ -232,14 +232,14 @@ def test_a_tip_wider_than_a_map_is_refused_when_the_pass_would_be_long(tmp_path)
 
 def test_a_tip_wider_than_the_scan_is_warned_about_in_one_line(tmp_path):
     small = tmp_path / "small.x3p"
-    rough("synth", "--size", "64x64", "--spacing", "10um", "--dimension", "2.3", "--rq", "5um", "-o", small, env=ENV)
+    rough("synth", "--size", "64x64", "--step", "10um", "--dimension", "2.3", "--rq", "5um", "-o", small, env=ENV)
     result = rough("detrend", "--tip", "0.5mm", small, "-o", tmp_path / "out.x3p", env=ENV)
     assert result.returncode == 0
     lines = result.stderr.decode().splitlines()
     assert lines == ["rough detrend: warning: a 500 µm tip (1 mm across) is wider than the 640 µm × 640 µm scan: "
                      "its path depends on where the scan ends"]  # fmt: skip
     profile = tmp_path / "profile.x3p"
-    rough("synth", "--points", "200", "--spacing", "10um", "--dimension", "1.3", "--rq", "5um", "-o", profile, env=ENV)
+    rough("synth", "--points", "200", "--step", "10um", "--dimension", "1.3", "--rq", "5um", "-o", profile, env=ENV)
     result = rough("detrend", "--tip", "fingertip", profile, "-o", tmp_path / "p.x3p", env=ENV)
     assert result.returncode == 0 and "wider than the 2 mm scan" in result.stderr.decode()
     inside = rough("detrend", "--tip", "0.2mm", small, "-o", tmp_path / "inside.x3p", env=ENV)
@@ -279,7 +279,7 @@ def test_a_profile_traced_in_tiles_is_scipys_grey_morphology_bit_for_bit(monkeyp
 def test_the_synthesis_inverse_transform_in_blocks_is_irfft2_bit_for_bit(shape):
     from scipy import fft
 
-    from rough.fractal import synth
+    from rough.fractal import synth, synth_map
 
     ny, nx = shape
     rng = np.random.default_rng(ny * nx)
@@ -288,8 +288,8 @@ def test_the_synthesis_inverse_transform_in_blocks_is_irfft2_bit_for_bit(shape):
     )
     expected = fft.irfft2(spectrum.copy(), (ny, nx), workers=-1).astype(np.float64)
     steps = []
-    heights = synth._inverse_transform(
-        spectrum, nx, synth._blocks(nx // 2 + 1, 7), synth._blocks(ny, 5), lambda: steps.append(1)
+    heights = synth_map._inverse_transform(
+        spectrum, nx, synth.slices(nx // 2 + 1, 7), synth.slices(ny, 5), lambda: steps.append(1)
     )
     assert np.array_equal(bits(heights), bits(expected))
-    assert len(steps) == len(synth._blocks(nx // 2 + 1, 7)) + len(synth._blocks(ny, 5))
+    assert len(steps) == len(synth.slices(nx // 2 + 1, 7)) + len(synth.slices(ny, 5))

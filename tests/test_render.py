@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 
 from rough import Surface
 from rough.errors import InputError
-from rough.fractal.resample import resample
+from rough.fractal.resampling import resample
 from rough.fractal.synth import synthesize_fragments, synthesize_profile
 from rough.render import DynamicStylus, QuasiStatic, Settings, Track, clamp, forces, run, simulate, write_trace
 from rough.render.device import Capabilities

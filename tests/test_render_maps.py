@@ -11,7 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from rough import Surface
-from rough.fractal.synth import _map_filter, synthesize_map
+from rough.fractal.synth_map import _map_filter, synthesize_map
 from rough.render import (
     GradientField,
     MapTrack,
@@ -135,7 +135,7 @@ def test_the_lateral_force_across_the_lay_exceeds_the_one_along_it_as_the_spectr
 
 def test_a_minute_on_an_80mm_profile_strokes_back_and_forth_and_stays_on_the_surface(tmp_path):
     source = rough("synth", "--length", "80mm", "--dimension", "1.275", "--rq", "0.2781mm", "--seed", "3", check=True)
-    profile = rough("resample", "--spacing", "0.1545mm", input=source.stdout, check=True).stdout
+    profile = rough("resample", "--step", "0.1545mm", input=source.stdout, check=True).stdout
     out = rough("render", "--duration", "60s", "--json", "--trace", tmp_path / "t.npy", input=profile, check=True)
     report = json.loads(out.stdout)["runs"][0]
     trace = np.load(tmp_path / "t.npy")

@@ -9,8 +9,8 @@ import pytest
 
 from rough import Surface, read
 from rough.errors import InputError
-from rough.fractal.rose import rose
-from rough.fractal.synth import synthesize_map
+from rough.fractal.sectors import rose
+from rough.fractal.synth_map import synthesize_map
 
 from conftest import assert_one_line_error, rough
 
@@ -93,7 +93,7 @@ def test_rose_command(tmp_path):
         "synth",
         "--size",
         "256x256",
-        "--spacing",
+        "--step",
         "10um",
         "--anisotropy",
         "2.2,1um,2.5,3um,30",
@@ -106,12 +106,12 @@ def test_rose_command(tmp_path):
     assert [sector["angle"] for sector in values["sectors"]] == [10.0 * k for k in range(18)]
     assert all({"fractal_dimension", "amplitude_coefficient"} <= set(sector) for sector in values["sectors"])
     assert (tmp_path / "rose.png").read_bytes()[:4] == b"\x89PNG"
-    rows = rough("rose", "--tsv", "--step", "30", input=surface, check=True).stdout.decode().splitlines()
+    rows = rough("rose", "--tsv", "--angle-step", "30", input=surface, check=True).stdout.decode().splitlines()
     angles = [row.split("\t")[2] for row in rows if re.search(r"\tsectors\.\d+\.angle\t", row)]
     assert angles == ["0.0", "30.0", "60.0", "90.0", "120.0", "150.0"]
     profile = rough("synth", "--length", "5mm", "--dimension", "1.3", "--rq", "0.1mm", "--seed", "1", check=True).stdout
     assert_one_line_error(rough("rose", input=profile), "a rose needs a map")
-    assert_one_line_error(rough("rose", "--step", "7", input=surface), "must divide 180")
+    assert_one_line_error(rough("rose", "--angle-step", "7", input=surface), "must divide 180")
 
 
 @pytest.mark.parametrize(

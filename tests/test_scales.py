@@ -14,7 +14,7 @@ import rough
 from rough import InputError, Surface
 from rough.fractal.fit import fit_fractal
 from rough.fractal.scales import reliability_cutoff, scale_dependent, scale_dependent_roughness
-from rough.fractal.synth import synthesize_map
+from rough.fractal.synth_map import synthesize_map
 from rough.metrology.tip import traced
 
 from fbm import fbm

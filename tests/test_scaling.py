@@ -9,9 +9,10 @@ import pytest
 from fourier import fourier_map, fourier_profile
 
 from rough import Surface
-from rough.fractal.fit import difference_periodogram, fit_fractal
-from rough.fractal.rose import rose
+from rough.fractal.fit import fit_fractal
 from rough.fractal.scaling import gof_p_value, profile_bins
+from rough.fractal.sectors import rose
+from rough.fractal.whittle import difference_periodogram
 
 from conftest import rough
 from fbm import fbm

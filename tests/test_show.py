@@ -14,7 +14,7 @@ import pytest
 
 import rough
 from rough import metrology
-from rough.fractal.synth import synthesize_map
+from rough.fractal.synth_map import synthesize_map
 
 from conftest import assert_one_line_error
 from conftest import rough as run_rough
@@ -59,7 +59,7 @@ def strip(tmp_path_factory):
 
 def test_a_map_as_png(tmp_path):
     out = tmp_path / "map.png"
-    result = run_rough("show", MAP, "-o", out)
+    result = run_rough("show", MAP, "--plot", out)
     assert result.returncode == 0, result.stderr.decode()
     assert result.stdout == b"" and result.stderr == b""
     width, height = png_size(out.read_bytes())
@@ -68,14 +68,14 @@ def test_a_map_as_png(tmp_path):
 
 def test_a_profile_as_png(tmp_path):
     out = tmp_path / "profile.png"
-    run_rough("show", PROFILE, "-o", out, check=True)
+    run_rough("show", PROFILE, "--plot", out, check=True)
     width, height = png_size(out.read_bytes())
     assert width / height > 2
 
 
 def test_a_wide_map_is_a_wide_strip_not_a_column(strip, tmp_path):
     out = tmp_path / "strip.png"
-    run_rough("show", strip, "-o", out, check=True)
+    run_rough("show", strip, "--plot", out, check=True)
     width, height = png_size(out.read_bytes())
     assert width / height > 3, (width, height)
 
@@ -84,14 +84,14 @@ def test_a_tall_map_is_tall(tmp_path):
     path = tmp_path / "tall.x3p"
     synthesize_map((40, 400), (10e-6, 10e-6), 2.3, rq=2e-6, seed=2).write(path)
     out = tmp_path / "tall.png"
-    run_rough("show", path, "-o", out, check=True)
+    run_rough("show", path, "--plot", out, check=True)
     width, height = png_size(out.read_bytes())
     assert height / width > 1.1, (width, height)  # the long title (the path) widens it a little
 
 
 def test_the_title_is_the_file_name_and_svg_is_written(tmp_path):
     out = tmp_path / "map.svg"
-    run_rough("show", MAP, "-o", out, check=True)
+    run_rough("show", MAP, "--plot", out, check=True)
     text = out.read_text()
     assert text.startswith("<?xml") and "<svg" in text
     assert f"<!-- {MAP} -->" in text  # matplotlib names each text drawn as paths in a comment
@@ -99,7 +99,7 @@ def test_the_title_is_the_file_name_and_svg_is_written(tmp_path):
 
 def test_title_option_and_format_option(tmp_path):
     out = tmp_path / "figure"  # no extension: --format says
-    run_rough("show", MAP, "-o", out, "--format", "svg", "--title", "Sample 7, fault face", check=True)
+    run_rough("show", MAP, "--plot", out, "--format", "svg", "--title", "Sample 7, fault face", check=True)
     assert "<!-- Sample 7, fault face -->" in out.read_text()
 
 
@@ -112,30 +112,30 @@ def test_standard_output_carries_png_and_standard_input_is_named(tmp_path):
 
 def test_pdf(tmp_path):
     out = tmp_path / "map.pdf"
-    run_rough("show", MAP, "-o", out, check=True)
+    run_rough("show", MAP, "--plot", out, check=True)
     assert out.read_bytes().startswith(b"%PDF")
 
 
 def test_hillshade_and_levelling(tmp_path):
     out = tmp_path / "shaded.png"
-    run_rough("show", MAP, "--hillshade", "--order", "1", "--dpi", "72", "-o", out, check=True)
+    run_rough("show", MAP, "--hillshade", "--order", "1", "--dpi", "72", "--plot", out, check=True)
     width, _ = png_size(out.read_bytes())
     assert width < 900  # 72 dpi, not 150
 
 
 def test_a_bad_input_is_one_line_status_2_and_no_file(tmp_path):
     out = tmp_path / "map.png"
-    assert_one_line_error(run_rough("show", tmp_path / "missing.x3p", "-o", out), "missing.x3p")
+    assert_one_line_error(run_rough("show", tmp_path / "missing.x3p", "--plot", out), "missing.x3p")
     bad = tmp_path / "bad.x3p"
     bad.write_bytes(b"not a zip archive")
-    assert_one_line_error(run_rough("show", bad, "-o", out), "bad.x3p")
+    assert_one_line_error(run_rough("show", bad, "--plot", out), "bad.x3p")
     assert not out.exists()
     assert not list(tmp_path.glob(".rough-*"))
 
 
 def test_an_unknown_extension_is_refused_before_any_work(tmp_path):
     out = tmp_path / "map.txt"
-    assert_one_line_error(run_rough("show", MAP, "-o", out), ".txt", "--format")
+    assert_one_line_error(run_rough("show", MAP, "--plot", out), ".txt", "--format")
     assert not out.exists()
 
 
@@ -162,7 +162,7 @@ def test_without_matplotlib_one_line_before_reading(tmp_path):
     fake.mkdir(parents=True)
     (fake / "__init__.py").write_text("raise ImportError('no matplotlib here')\n")
     path = os.pathsep.join(filter(None, [str(fake.parent), os.environ.get("PYTHONPATH")]))
-    result = run_rough("show", tmp_path / "missing.x3p", "-o", tmp_path / "x.png", env={"PYTHONPATH": path})
+    result = run_rough("show", tmp_path / "missing.x3p", "--plot", tmp_path / "x.png", env={"PYTHONPATH": path})
     assert_one_line_error(result, "matplotlib", "pip install", status=1)  # not "missing.x3p: no such file"
 
 
@@ -272,7 +272,7 @@ def test_a_real_scan_with_invalid_points(shared_data, tmp_path):
     assert "invalid (NaN): 25,292 points" in texts(figure)
     assert image_ratio(figure) == pytest.approx(918 / 256, rel=0.02)
     out = tmp_path / "land.png"
-    run_rough("show", path, "-o", out, check=True)
+    run_rough("show", path, "--plot", out, check=True)
     width, height = png_size(out.read_bytes())
     assert width > height
 
@@ -283,7 +283,7 @@ def test_a_real_scan_with_unequal_spacing(shared_data, tmp_path):
     assert image_ratio(figure) == pytest.approx(8.29767313942749e-5 / 2.044783737930349e-4, rel=0.02)
     assert figure.axes[0].get_xlabel() == "x (µm)"
     out = tmp_path / "x3p-2.png"
-    run_rough("show", path, "-o", out, check=True)
+    run_rough("show", path, "--plot", out, check=True)
     width, height = png_size(out.read_bytes())
     assert height > 1.15 * width  # the title and the facts above it are wider than the map
 
@@ -334,3 +334,20 @@ def test_the_wilson_interval_without_statsmodels(monkeypatch):
         assert plots.proportion_interval(k, n) == pytest.approx(interval, abs=1e-12)
     # Wilson (1927) for 6 of 8 at 95 %: 0.4093 to 0.9285
     assert plots.proportion_interval(6, 8) == pytest.approx((0.40927, 0.92849), abs=1e-4)
+
+
+def test_the_plots_stub_loads_matplotlib_only_to_draw():
+    code = (
+        "import sys; from rough import plots; "
+        "print('matplotlib' in sys.modules, plots.length_unit(6.4e-3), plots.proportion_interval(6, 8)[0] > 0.4); "
+        "plots.surface_figure; print('matplotlib' in sys.modules)"
+    )
+    env = {**os.environ, "PYTHONPATH": str(pathlib.Path(rough.__file__).parent.parent)}
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, env=env, check=True)
+    assert result.stdout.decode().split("\n")[:2] == ["False (1000.0, 'mm') True", "False"]
+
+
+def test_no_plots_module_shadows_a_public_name():
+    modules = {path.stem for path in pathlib.Path(plots.__file__).parent.glob("*.py")}
+    assert not modules & set(plots.__all__)
+    assert all(getattr(plots, name) is not None for name in plots.__all__)

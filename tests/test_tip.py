@@ -418,8 +418,6 @@ def test_ctrl_c_stops_the_workers_after_their_current_chunk(monkeypatch):
     import threading
     import time
 
-    import rough.progress
-
     monkeypatch.setattr(tip, "CHUNK_SECONDS", 1e-7)  # a row a chunk: 400 chunks
     kernel, calls = compiled(tip._rows), []
 
@@ -445,7 +443,7 @@ def test_ctrl_c_stops_the_workers_after_their_current_chunk(monkeypatch):
             raise KeyboardInterrupt
 
     monkeypatch.setattr(tip, "compiled", lambda function: slow)
-    monkeypatch.setattr(rough.progress, "progress", Interrupted)
+    monkeypatch.setattr(tip, "progress", Interrupted)
     before = threading.active_count()
     with pytest.raises(KeyboardInterrupt):
         traced(Surface(random_heights((400, 300), seed=3), (1e-5, 1e-5)), 1e-4)

@@ -211,7 +211,7 @@ def test_real_files_read_as_index_lists(shared_data, path):
 
 def test_x3p2_rms_height_matches_surfacetopography(shared_data):
     from rough.io import read
-    from rough.summary import summary
+    from rough.metrology import summary
 
     facts = summary(read(shared_data / "SurfaceTopography/x3p-2.x3p"))
     assert facts["Sq"] == pytest.approx(7.728033273597876e-08, rel=1e-9)

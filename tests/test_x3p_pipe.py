@@ -1,4 +1,4 @@
-"""The X3P pass-through: a stream hashed as it arrives (``x3p.receive``), digests
+"""The X3P pass-through: a stream hashed as it arrives (``receiving.receive``), digests
 reused when heights pass unchanged, and the zip writer whose local headers hold every
 size, on pipes too. Corrupted data must still be refused on the fast path."""
 
@@ -20,7 +20,7 @@ from hypothesis import strategies as st
 
 from rough import Surface
 from rough.errors import FormatError, InputError
-from rough.io import limits, read_bytes, x3p
+from rough.io import read_bytes, receiving, x3p, ziparchive
 
 from conftest import assert_one_line_error, rough
 from x3p_files import GRID, written, x3p_file
@@ -52,22 +52,22 @@ class Trickle(io.RawIOBase):
 
 
 def received(blob, pieces=(1, 7, 4096, 65536, 3)):
-    return limits.read_capped(io.BufferedReader(Trickle(blob, pieces), buffer_size=16), "<stdin>")
+    return receiving.read_capped(io.BufferedReader(Trickle(blob, pieces), buffer_size=16), "<stdin>")
 
 
 @pytest.fixture(autouse=True)
 def small_members_hashed(monkeypatch):
     """The test maps are small: hash their members on the way in as a large map's are."""
-    monkeypatch.setattr(x3p, "HASHED_FROM", 1)
+    monkeypatch.setattr(receiving, "HASHED_FROM", 1)
 
 
 @pytest.fixture
 def small_steps(monkeypatch):
     """Steps small enough that a test map crosses many: reads, hashing jobs and the
     buffer's growth."""
-    monkeypatch.setattr(x3p, "RECEIVE_STEP", 97)
-    monkeypatch.setattr(x3p, "HASH_STEP", 64)
-    monkeypatch.setattr(x3p, "FIRST_CAPACITY", 16)
+    monkeypatch.setattr(receiving, "RECEIVE_STEP", 97)
+    monkeypatch.setattr(receiving, "HASH_STEP", 64)
+    monkeypatch.setattr(receiving, "FIRST_CAPACITY", 16)
 
 
 def map_with_holes(shape=(40, 30), seed=5):
@@ -91,22 +91,22 @@ def test_a_stream_in_pieces_arrives_whole_and_hashed(small_steps, pieces):
 
 def test_a_stream_whose_first_read_is_shorter_than_a_zip_signature_is_read_as_before():
     blob = written(map_with_holes())
-    data = limits.read_capped(io.BufferedReader(Trickle(blob, (1, 5000), first=1)), "<stdin>")
+    data = receiving.read_capped(io.BufferedReader(Trickle(blob, (1, 5000), first=1)), "<stdin>")
     assert data == blob and isinstance(data, bytes)
     assert np.array_equal(read_bytes(data).heights, map_with_holes().heights, equal_nan=True)
 
 
 def test_only_zip_archives_are_received_into_a_view():
     text = b"x[mm]\tz[um]\n0\t1\n1\t2\n"
-    assert limits.read_capped(io.BufferedReader(Trickle(text)), "<stdin>") == text
-    assert x3p.receive(io.BytesIO(b"PK\x03\x04"), "<stdin>", 100) is None  # no peek: read as before
+    assert receiving.read_capped(io.BufferedReader(Trickle(text)), "<stdin>") == text
+    assert receiving.receive(io.BytesIO(b"PK\x03\x04"), "<stdin>", 100) is None  # no peek: read as before
 
 
 def test_a_regular_file_is_received_at_its_size(tmp_path):
     path = tmp_path / "map.x3p"
     map_with_holes().write(path)
     with open(path, "rb") as stream:
-        view = limits.read_capped(stream, str(path))
+        view = receiving.read_capped(stream, str(path))
     assert bytes(view) == path.read_bytes() and len(view.obj) == len(view)
 
 
@@ -121,7 +121,7 @@ def test_a_regular_file_is_looked_at_without_filling_its_buffer(tmp_path):
     for name in ("map.gsf", "map.x3p"):
         map_with_holes().write(tmp_path / name)
         with NoPeek(io.FileIO(tmp_path / name)) as stream:
-            assert bytes(limits.read_capped(stream, name)) == (tmp_path / name).read_bytes()
+            assert bytes(receiving.read_capped(stream, name)) == (tmp_path / name).read_bytes()
 
 
 @pytest.mark.parametrize("regular", [False, True])
@@ -134,19 +134,19 @@ def test_a_stream_past_the_cap_is_refused(tmp_path, monkeypatch, regular):
     else:
         stream = io.BufferedReader(Trickle(blob))
     with stream, pytest.raises(InputError, match="larger than"):
-        limits.read_capped(stream, "<stdin>")
+        receiving.read_capped(stream, "<stdin>")
     monkeypatch.setenv("ROUGH_MAX_INPUT_BYTES", str(len(blob)))
     assert bytes(received(blob)) == blob
 
 
 def test_only_the_first_few_large_members_are_hashed_on_the_way_in(monkeypatch):
-    monkeypatch.setattr(x3p, "HASHED_FROM", 1000)
+    monkeypatch.setattr(receiving, "HASHED_FROM", 1000)
     buffer = io.BytesIO()
     with zipfile.ZipFile(buffer, "w") as archive:
         for index in range(3000):
             archive.writestr(f"m{index}", bytes(1000 if index % 2 else 10))
     view = received(buffer.getvalue())
-    assert sorted(size for size, _ in view.obj.regions.values()) == [1000] * x3p.HASHED_AT_MOST
+    assert sorted(size for size, _ in view.obj.regions.values()) == [1000] * receiving.HASHED_AT_MOST
 
 
 def test_a_failing_stream_leaves_no_hashing_thread(small_steps):
@@ -158,7 +158,7 @@ def test_a_failing_stream_leaves_no_hashing_thread(small_steps):
 
     before = threading.active_count()
     with pytest.raises(OSError, match="the pipe broke"):
-        limits.read_capped(io.BufferedReader(Broken(written(map_with_holes()))), "<stdin>")
+        receiving.read_capped(io.BufferedReader(Broken(written(map_with_holes()))), "<stdin>")
     assert threading.active_count() == before
 
 
@@ -169,7 +169,7 @@ def test_a_hash_failing_in_the_worker_leaves_the_check_to_the_reader(monkeypatch
 
     blob = written(map_with_holes())
     with monkeypatch.context() as patch:
-        patch.setattr(x3p.hashlib, "md5", Failing)
+        patch.setattr(receiving.hashlib, "md5", Failing)
         view = received(blob)
     assert bytes(view) == blob and view.obj.regions == {}
     assert np.array_equal(read_bytes(view).heights, map_with_holes().heights, equal_nan=True)
@@ -283,9 +283,9 @@ def test_heights_read_and_written_unchanged_are_not_hashed_again(monkeypatch):
         blob = written(surface)
         view = received(blob)
         hashed = []
-        original = x3p._hashes
+        original = receiving.hashes
         with monkeypatch.context() as patch:
-            patch.setattr(x3p, "_hashes", lambda content: hashed.append(len(content)) or original(content))
+            patch.setattr(receiving, "hashes", lambda content: hashed.append(len(content)) or original(content))
             again = read_bytes(view)
             assert not again.heights.flags.writeable
             out = written(again.derive("convert", {}))
@@ -350,9 +350,9 @@ def _central_entries(blob):
 
 @pytest.mark.parametrize("size", [10, 1 << 21])
 def test_hashes_in_one_pass_match_hashlib_and_zlib(monkeypatch, size):
-    monkeypatch.setattr(x3p, "HASH_STEP", 1024)
+    monkeypatch.setattr(receiving, "HASH_STEP", 1024)
     content = np.random.default_rng(size).bytes(size)
-    assert x3p._hashes(memoryview(content)) == (hashlib.md5(content).hexdigest(), zlib.crc32(content))
+    assert receiving.hashes(memoryview(content)) == (hashlib.md5(content).hexdigest(), zlib.crc32(content))
 
 
 # -- the writer ------------------------------------------------------------------------
@@ -375,7 +375,7 @@ def x3p_regions(blob):
 
 
 def test_zip64_fields_where_sizes_need_them(monkeypatch, tmp_path):
-    monkeypatch.setattr(x3p, "ZIP64_LIMIT", 100)  # every member past the first and every offset
+    monkeypatch.setattr(ziparchive, "ZIP64_LIMIT", 100)  # every member past the first and every offset
     surface = map_with_holes()
     blob = written(surface)
     with zipfile.ZipFile(io.BytesIO(blob)) as archive:
@@ -403,8 +403,8 @@ def test_a_failed_write_leaves_no_file(tmp_path, monkeypatch):
             raise OSError(28, "No space left on device")
         return original(self, name, content, crc, align)
 
-    original = x3p._ZipWriter.add
-    monkeypatch.setattr(x3p._ZipWriter, "add", fail)
+    original = ziparchive.ZipWriter.add
+    monkeypatch.setattr(ziparchive.ZipWriter, "add", fail)
     with pytest.raises(OSError, match="No space left"):
         map_with_holes().write(tmp_path / "map.x3p")
     assert list(tmp_path.iterdir()) == []

@@ -14,8 +14,8 @@ import numpy as np
 
 import rough
 import rough.plots
+from rough.fractal.filling import fill_invalid
 from rough.fractal.psd import binned_spectrum
-from rough.fractal.resample import fill_invalid
 
 scan = rough.read(rough.sample("rock-map.x3p"))
 nx, ny = scan.points

@@ -3,7 +3,7 @@ Direction dependence: the amplitude coefficient rose
 ====================================================
 
 Bedding, striations and wear give many surfaces a direction: heights vary faster
-across the lay than along it. :func:`rough.rose <rough.fractal.rose.rose>` fits the
+across the lay than along it. :func:`rough.rose <rough.fractal.sectors.rose>` fits the
 surface dimension Ds(θ) and the amplitude coefficient C(θ) in direction sectors of one
 2-D power spectrum. θ is the **wavevector** direction, counter-clockwise from +x: the
 direction in which the heights vary. The ridges (the lay) run at right angles to it.

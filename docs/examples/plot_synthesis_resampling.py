@@ -42,7 +42,7 @@ print(f"{points} points at {SPACING * 1e3} mm, Rq = {rough.parameters(fine)['Rq'
 # Resampling
 # ----------
 #
-# :func:`rough.resample <rough.fractal.resample.resample>` coarsens by the ratio 1/5
+# :func:`rough.resample <rough.fractal.resampling.resample>` coarsens by the ratio 1/5
 # with a polyphase anti-aliasing filter: it removes the wavelengths the new spacing
 # cannot hold instead of folding them back. Rq hardly changes (it lives in the long
 # wavelengths). The fit after resampling stops at 80 % of the new Nyquist frequency,

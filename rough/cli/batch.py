@@ -1,14 +1,19 @@
 """Several inputs in one call: each is read and worked on in turn, a bad one is
 reported in one line and skipped, and the exit status at the end is the worst seen.
 
-Side files (``--plot``, ``--psd``, ``--list``, ``show -o``) then need ``{stem}`` (the
+Side files (``--plot``, ``--psd``, ``--list``, ``--segments``) then need ``{stem}`` (the
 input's name without directory and extension) or ``{name}`` in their names, and a
 surface output ``-o`` names a directory (``out/``).
 """
 
 import os
+import sys
 
 import click
+
+from .. import errors, io, progress
+from .main import current_input, failure, say
+from .report import Printer, collected_warnings
 
 #: The options that name a file written beside the report (or instead of one), and their flags.
 SIDE_FILES = {
@@ -16,7 +21,6 @@ SIDE_FILES = {
     "psd_file": "--psd",
     "feature_list": "--list",
     "segments": "--segments",
-    "figure_file": "-o",
 }
 
 
@@ -24,8 +28,6 @@ def run_each(work, names, options):
     """Call ``work(name, **options)`` for each input in ``names`` and print the
     :class:`~rough.cli.report.Report` it returns (if any) in the format of
     ``options``' ``as_json``/``as_tsv``. Returns the exit status."""
-    from .report import Printer
-
     many = len(names) > 1
     check_inputs(names)
     printer = Printer(options.pop("as_json", False), options.pop("as_tsv", False), many)
@@ -50,24 +52,18 @@ def run_each(work, names, options):
 
 def read_named(name, options):
     """The surface in input ``name`` (see :func:`rough.io.read`)."""
-    from ..io import read
-
-    return read(name, **options)
+    return io.read(name, **options)
 
 
 def _one(work, name, options, many):
     """(report, warnings, status) of one input; with several, a failure is reported
     and its status returned instead of raised."""
-    from ..errors import InputError
-    from . import main
-    from .report import collected_warnings
-
-    main.current_input[:] = [printable_name(name)] if many else []
+    current_input[:] = [printable_name(name)] if many else []
     try:
         with collected_warnings() as warnings:
             report = work(name, **options)
         return report, warnings, 0
-    except InputError as error:
+    except errors.InputError as error:
         failed = _named_error(error, name)
         if not many:
             raise
@@ -78,9 +74,9 @@ def _one(work, name, options, many):
             raise
         failed = error
     finally:
-        main.current_input[:] = []
-    message, status = main.failure(failed)
-    main.say(message)
+        current_input[:] = []
+    message, status = failure(failed)
+    say(message)
     return None, [], status
 
 
@@ -105,12 +101,8 @@ def stem_name(template, name):
 def check_inputs(names):
     if names.count("-") > 1:
         raise click.UsageError("standard input (-) can be read only once")
-    import sys
-
     if "-" in names and sys.stdin is None:
-        from ..errors import InputError
-
-        raise InputError("<stdin>: standard input is closed")
+        raise errors.InputError("<stdin>: standard input is closed")
 
 
 def _check_side_files(side):
@@ -125,6 +117,4 @@ def _check_side_files(side):
 def _progress(names, many):
     if not many:
         return names
-    from ..progress import progress
-
-    return progress(names, total=len(names), description="files", unit="file")
+    return progress.progress(names, total=len(names), description="files", unit="file")

@@ -2,18 +2,32 @@
 
 import click
 
+from ..io import registry
 from .options import surface_input, surface_output
 
 
-@click.command(short_help="Convert between X3P, OpenEXR, GSF, TSV and NPY.")
+class WritesCommand(click.Command):
+    """A command whose help ends with the formats rough writes, from the registry (read
+    when the help is shown: the format modules load numpy)."""
+
+    @property
+    def epilog(self):
+        titles = [registry.formats()[name].title for name in registry.writable()]
+        return f"Writes {', '.join(titles[:-1])} and {titles[-1]}; reads every format of 'rough formats'."
+
+    @epilog.setter
+    def epilog(self, value):
+        pass
+
+
+@click.command(cls=WritesCommand, short_help="Convert between the formats rough reads and writes.")
 @surface_input
 @surface_output
 def convert(surface, input, output):
     """Read INPUT (default: standard input) in any format rough reads, and write it
     in the format given by -f or the output file's extension (X3P on standard
     output). Heights, spacing, origin, units, metadata and history are kept as far
-    as the output format can hold them (NPY keeps heights only; GSF and EXR store
-    float32 heights).
+    as the output format can hold them ('rough formats' says what each carries).
 
     \b
     Examples:

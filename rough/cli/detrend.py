@@ -3,7 +3,8 @@ and what a round tip traces (the ISO 16610-41 closing envelope)."""
 
 import click
 
-from .options import LENGTH, TIP, crop_option, surface_input, surface_output
+from .. import metrology
+from .options import LENGTH, TIP, RegistryChoice, crop_option, surface_input, surface_output
 
 
 @click.command(short_help="Remove polynomial form; split roughness and waviness (ISO 16610); trace with a round tip.")
@@ -18,7 +19,7 @@ from .options import LENGTH, TIP, crop_option, surface_input, surface_output
 @click.option("--cutoff", type=LENGTH, help="Gaussian filter cut-off λc (ISO 16610-21; 16610-61 for maps), e.g. 0.8mm.")
 @click.option(
     "--keep",
-    type=click.Choice(["roughness", "waviness", "form"]),
+    type=RegistryChoice(lambda: metrology.KEEP),
     default="roughness",
     show_default=True,
     help="What to output: the roughness (form removed, filtered with --cutoff), the waviness (the "
@@ -26,7 +27,7 @@ from .options import LENGTH, TIP, crop_option, surface_input, surface_output
 )
 @click.option(
     "--ends",
-    type=click.Choice(["trim", "correct"]),
+    type=RegistryChoice(lambda: metrology.ENDS),
     default="trim",
     show_default=True,
     help="Filter end effects: trim λc/2 at each end, or keep the full length with the renormalised "
@@ -51,8 +52,8 @@ def detrend(surface, input, order, cutoff, keep, ends, tip, envelope, output):
     output instead what a round tip of that radius traces (the path of its apex, as a
     stylus profilometer records it and a hand holding the probe feels it); with
     --envelope, the closing envelope (the best estimate of the material surface from a
-    traced one). These remove no polynomial unless --order is given too. Lengths take a
-    unit; a bare number is in mm. NaN points stay NaN and never touch the tip.
+    traced one). These remove no polynomial unless --order is given too. Lengths name
+    their unit. NaN points stay NaN and never touch the tip.
 
     \b
     Examples:
@@ -62,23 +63,21 @@ def detrend(surface, input, order, cutoff, keep, ends, tip, envelope, output):
         rough detrend --tip fingernail rock.x3p | rough features
         rough detrend --envelope 2um stylus-scan.x3p -o material.x3p
     """
-    from ..metrology import detrend as remove
-    from ..metrology import split
-    from ..metrology.tip import closing_envelope, traced
-
     if tip is not None and envelope is not None:
         raise click.UsageError("give --tip or --envelope, not both")
     probe = tip if tip is not None else envelope
     if probe is None:
-        output.write(remove(surface, order=2 if order is None else order, cutoff=cutoff, keep=keep, ends=ends))
+        output.write(
+            metrology.detrend(surface, order=2 if order is None else order, cutoff=cutoff, keep=keep, ends=ends)
+        )
         return
     if keep == "form":
         raise click.UsageError("--keep form needs a polynomial, not --tip/--envelope")
     if keep == "waviness" and cutoff is None:
         raise click.UsageError("the waviness needs a cut-off (--cutoff)")
     if order is not None:
-        surface = remove(surface, order=order)
-    surface = traced(surface, probe) if tip is not None else closing_envelope(surface, probe)
+        surface = metrology.detrend(surface, order=order)
+    surface = metrology.traced(surface, probe) if tip is not None else metrology.closing_envelope(surface, probe)
     if cutoff is not None:
-        surface = split(surface, cutoff, keep, ends)
+        surface = metrology.split(surface, cutoff, keep, ends)
     output.write(surface)

@@ -1,11 +1,17 @@
 """rough experiment: paired-comparison roughness perception, from design to analysis."""
 
+import logging
 import math
+import secrets
 
 import click
 
+from .. import experiment as experiments
+from .. import extras, io, plots, render
+from ..errors import InputError
+from ..units import format_length, parse_length
 from .haptics import SPEED, TIME, haptic_options
-from .options import LENGTH, LENGTHS, FloatRange, plot_option, report_format
+from .options import LENGTH, LENGTHS, FloatRange, bare_number, plot_option, renamed, report_format
 from .report import Report, collected_warnings, emit
 
 
@@ -50,8 +56,10 @@ def experiment():
     "--subjects", help="A number of subjects (named S01, S02, …) or their names, comma-separated (default 14)."
 )
 @click.option("--length", type=LENGTH, help="Profile length (default 80 mm).")
-@click.option("--spacing", type=LENGTH, help="Stored (rendered) spacing (default 0.1545 mm).")
-@click.option("--synthesis-spacing", type=LENGTH, help="Spacing the surfaces are synthesised at (default 0.0309 mm).")
+@click.option("--step", type=LENGTH, help="Spacing of the surfaces stored and rendered (default 0.1545 mm).")
+@renamed("--spacing", "--step", "step", LENGTH)
+@click.option("--synthesis-step", type=LENGTH, help="Spacing the surfaces are synthesised at (default 0.0309 mm).")
+@renamed("--synthesis-spacing", "--synthesis-step", "synthesis_step", LENGTH)
 @click.option(
     "--seed", type=click.IntRange(0), help="Seed of the surfaces and the randomisation (default: drawn and recorded)."
 )
@@ -64,8 +72,8 @@ def design(
     rq_factor,
     subjects,
     length,
-    spacing,
-    synthesis_spacing,
+    step,
+    synthesis_step,
     seed,
     as_json,
     as_tsv,
@@ -75,38 +83,30 @@ def design(
     (every reference against each of its eight (D, Rq) neighbours) in random order with
     a random side. --preset costa2000 is the paper's design.
     """
-    import secrets
-
-    from ..errors import InputError
-    from ..experiment.design import COSTA2000, grid_design, subject_ids, write_study
-
-    defaults = COSTA2000
+    defaults = experiments.COSTA2000
     if not references and preset is None:
         raise InputError("give --preset costa2000 or at least one --reference D,RQ")
     chosen = [_reference(text) for text in references] or defaults["references"]
     seed = secrets.randbits(32) if seed is None else seed
-    surfaces, sets = grid_design(
+    surfaces, sets = experiments.grid_design(
         chosen, dimension_step or defaults["dimension_step"], rq_factor or defaults["rq_factor"]
     )
     length = length or defaults["length"]
-    spacings = {"--synthesis-spacing": synthesis_spacing or defaults["synthesis_spacing"]}
-    spacings["--spacing"] = spacing or defaults["spacing"]
-    for flag, step in spacings.items():
-        if round(length / step) < 2:
-            from ..units import format_length
-
+    steps = {"--synthesis-step": synthesis_step or defaults["synthesis_spacing"], "--step": step or defaults["spacing"]}
+    for flag, spacing in steps.items():
+        if round(length / spacing) < 2:
             raise InputError(
-                f"--length {format_length(length)} holds fewer than two samples at {flag} {format_length(step)}"
+                f"--length {format_length(length)} holds fewer than two samples at {flag} {format_length(spacing)}"
             )
-    result = write_study(
+    result = experiments.write_study(
         study,
         surfaces,
         sets,
-        subject_ids(subjects or defaults["subjects"]),
+        experiments.subject_ids(subjects or defaults["subjects"]),
         seed,
         length,
-        spacings["--synthesis-spacing"],
-        spacings["--spacing"],
+        steps["--synthesis-step"],
+        steps["--step"],
         preset,
     )
     rows = [
@@ -135,9 +135,6 @@ def design(
 
 
 def _reference(text):
-    from ..errors import InputError
-    from ..units import parse_length
-
     parts = text.split(",")
     if len(parts) != 2:
         raise InputError(f"--reference {text!r}: write D,RQ, e.g. 1.275,0.2781mm")
@@ -147,7 +144,8 @@ def _reference(text):
         raise InputError(f"--reference {text!r}: {parts[0]!r} is not a fractal dimension") from None
     if not 1 < dimension < 2:
         raise InputError(f"--reference {text!r}: a profile's D lies between 1 and 2")
-    rq = parse_length(parts[1])
+    bare_number(parts[1], "--reference", "mm")
+    rq = parse_length(parts[1], "mm")
     if not LENGTHS[0] <= rq <= LENGTHS[1]:
         raise InputError(f"--reference {text!r}: Rq must lie between 1 pm and 10000 km")
     return dimension, rq
@@ -182,26 +180,19 @@ def run(study, subject, haptics, observer, speed, stroke, realtime):
     is rougher", button 3 (or key 2) "the second". Ctrl-C pauses the session. With
     --device sim, --observer answers.
     """
-    from ..errors import InputError
-    from ..experiment.design import is_name, load_study
-    from ..experiment.observer import parse_observer
-    from ..experiment.session import run_session, simulated_presenter
-
-    if not is_name(subject):
+    if not experiments.is_name(subject):
         raise InputError(f"--subject {subject!r}: not a name (letters, digits, - and _ only)")
-    loaded = load_study(study)
+    loaded = experiments.load_study(study)
     loaded.trials_of(subject)
     contact, friction = haptics.contact(), haptics.friction_model()
     if haptics.simulated:
         if observer is None:
             raise InputError("the simulated hand needs a scripted --observer (e.g. --observer rq=12,dimension=-4)")
-        from ..render.hand import HAND_DAMPING
-
-        haptics.warn_if_unstable(HAND_DAMPING)
-        present = simulated_presenter(
-            loaded, parse_observer(observer), speed, contact, friction, haptics.settings(stroke, realtime)
+        haptics.warn_if_unstable(render.HAND_DAMPING)
+        present = experiments.simulated_presenter(
+            loaded, experiments.parse_observer(observer), speed, contact, friction, haptics.settings(stroke, realtime)
         )
-        progress = run_session(loaded, subject, present, "sim")
+        progress = experiments.run_session(loaded, subject, present, "sim")
     else:
         progress = _joystick_session(loaded, subject, haptics, contact, friction)
     if progress.interrupted:
@@ -213,21 +204,15 @@ def run(study, subject, haptics, observer, speed, stroke, realtime):
 
 
 def _joystick_session(study, subject, haptics, contact, friction):
-    from .. import read
-    from ..experiment.session import Keyboard, joystick_presenter, run_session
-    from ..render import Track
-    from ..render.hand import PRESS
-    from ..render.session import open_joystick
-
-    tracks = {name: Track.from_surface(read(study.surface_path(name))) for name in study.surfaces}
-    joystick, _ = open_joystick(
+    tracks = {name: render.Track.from_surface(io.read(study.surface_path(name))) for name in study.surfaces}
+    joystick, _ = render.open_joystick(
         haptics.device, list(tracks.values()), haptics.max_force, haptics.stick_span, haptics.invert
     )
-    model = haptics.device_model(contact, PRESS, joystick)
-    keyboard = Keyboard()
+    model = haptics.device_model(contact, render.PRESS, joystick)
+    keyboard = experiments.Keyboard()
     try:
-        present = joystick_presenter(tracks, joystick, model, friction, haptics.settings(), keyboard)
-        return run_session(study, subject, present, joystick.label)
+        present = experiments.joystick_presenter(tracks, joystick, model, friction, haptics.settings(), keyboard)
+        return experiments.run_session(study, subject, present, joystick.label)
     finally:
         keyboard.close()
         joystick.close()
@@ -247,28 +232,18 @@ def analyze(study, set_id, plot, as_json, as_tsv):
     W = β/SE and p = 2(1 − Φ(abs(W))), as the paper's Tables 1-2 do, with likelihood-ratio
     tests for D and Rq. Warns under (quasi-)separation, where Wald tests mislead.
     """
-
-    from ..experiment.analysis import answers_table, fit
-    from ..experiment.design import load_study
-    from ..extras import require
-
-    require("statsmodels")
-
+    extras.require("statsmodels")
     with collected_warnings() as warnings:
-        loaded = load_study(study)
-        result = fit(answers_table(loaded, set_id), loaded.subjects)
+        loaded = experiments.load_study(study)
+        result = experiments.fit(experiments.answers_table(loaded, set_id), loaded.subjects)
         _warn_separation(result)
     if plot:
-        from .. import plots
-
         sets = [set_id] if set_id else [s["id"] for s in loaded.sets]
         plots.save(plots.percentage_figure(loaded, sets, title=str(study)), plot)
     emit(Report(_table(loaded, result, set_id), result.as_dict()), as_json, as_tsv, study, warnings)
 
 
 def _warn_separation(result):
-    import logging
-
     if result.separation:
         logging.getLogger("rough").warning(
             "(quasi-)separation: some answers are predicted with certainty (e.g. a subject who always chose the same "

@@ -2,10 +2,23 @@
 slides' feature detection and Rq against evaluation length."""
 
 import dataclasses
+import logging
 
 import click
 
-from .options import LENGTH, POSITION, RATIO, RATIOS, FloatRange, crop_option, plot_option, report_format, surface_input
+from .. import errors, io, metrology, plots, units
+from .options import (
+    LENGTH,
+    POSITION,
+    RATIO,
+    RATIOS,
+    FloatRange,
+    RegistryChoice,
+    crop_option,
+    plot_option,
+    report_format,
+    surface_input,
+)
 from .report import Report, on_stdout, shown
 
 
@@ -17,7 +30,7 @@ from .report import Report, on_stdout, shown
 )
 @click.option(
     "--ends",
-    type=click.Choice(["trim", "correct"]),
+    type=RegistryChoice(lambda: metrology.ENDS),
     default="trim",
     show_default=True,
     help="With --cutoff: trim λc/2 at each end, or keep the full length.",
@@ -30,7 +43,7 @@ from .report import Report, on_stdout, shown
 )
 @click.option(
     "--slope",
-    type=click.Choice(["2point", "7point"]),
+    type=RegistryChoice(lambda: metrology.SLOPES),
     default="2point",
     show_default=True,
     help="Slope for Rdq/Sdq/Sdr: forward differences, or ISO 4287's seven-point derivative.",
@@ -47,7 +60,7 @@ from .report import Report, on_stdout, shown
 )
 @click.option(
     "--acf",
-    type=click.Choice(["iso", "per-lag"]),
+    type=RegistryChoice(lambda: metrology.ACFS),
     default="iso",
     show_default=True,
     help="Maps: the autocorrelation of Sal and Str: ISO 25178-2's (products summed over the overlap, over the "
@@ -62,14 +75,14 @@ from .report import Report, on_stdout, shown
 )
 @click.option(
     "--detect-mode",
-    type=click.Choice(["A", "B"]),
+    type=RegistryChoice(lambda: metrology.MODES),
     default="B",
     show_default=True,
     help="Feature detection: B widens runs over 2·Rq_hf by 30 %; A makes the threshold grow with width.",
 )
 @click.option(
     "--polarity",
-    type=click.Choice(["peaks", "pits", "both"]),
+    type=RegistryChoice(lambda: metrology.POLARITIES),
     default="both",
     show_default=True,
     help="Feature detection: which features to find.",
@@ -119,7 +132,7 @@ from .report import Report, on_stdout, shown
 )
 @click.option(
     "--edge-features",
-    type=click.Choice(["exclude", "include"]),
+    type=RegistryChoice(lambda: metrology.EDGES),
     default="exclude",
     show_default=True,
     help="Maps: leave out, or count, the hills and dales that touch the border or invalid points.",
@@ -183,10 +196,6 @@ def features(
         rough features --pruning 10 --segments motifs.tsv scan.x3p
         rough features --vs-length rock.tsv
     """
-    from .. import metrology
-    from ..io.atomic import atomic_output
-    from ..metrology.segmentation import undefined_reasons
-
     report = not on_stdout(list=feature_list, plot=plot, segments=segments)
     evaluated = surface if cutoff is None else metrology.split(surface, cutoff, "roughness", ends)
     settings = Settings(
@@ -202,9 +211,9 @@ def features(
         acf,
     )
     if segments and (surface.is_profile or along):
-        from ..errors import InputError
-
-        raise InputError("--segments needs a map evaluated as a map, without --along (a profile's features: --list)")
+        raise errors.InputError(
+            "--segments needs a map evaluated as a map, without --along (a profile's features: --list)"
+        )
     values = metrology.parameters(
         evaluated,
         sampling_lengths=sampling_lengths,
@@ -227,13 +236,13 @@ def features(
     if not (surface.is_profile or along):
         hills, dales = (metrology.segment(evaluated, kind, pruning) for kind in ("hills", "dales"))
         featured = metrology.motif_parameters(evaluated, hills, dales, edge_features)
-        metrology.announce_undefined(featured, undefined_reasons(hills, dales, edge_features))
+        metrology.announce_undefined(featured, metrology.undefined_reasons(hills, dales, edge_features))
         segmentation = _segmentation(pruning, edge_features, values["Sz"])
         rows += _value_rows(featured, metrology.FEATURE, {"Spd": segmentation["text"]})
         document.update(featured)
         document["evaluation"]["segmentation"] = segmentation["settings"]
         if segments:
-            with atomic_output(segments) as stream:
+            with io.atomic_output(segments) as stream:
                 stream.write(_segment_table(hills, dales, pruning).encode())
     found = []
     if surface.is_profile:
@@ -260,11 +269,9 @@ def features(
         document["rq_vs_length"] = scaling
         rows += _scaling_rows(scaling)
     if feature_list:
-        with atomic_output(feature_list) as stream:
+        with io.atomic_output(feature_list) as stream:
             stream.write(_feature_table(found).encode())
     if plot:
-        from .. import plots
-
         curve = metrology.MaterialRatioCurve(evaluated)
         figure = plots.features_figure(evaluated, found, (centres, density), curve, title=shown(input))
         plots.save(figure, plot)
@@ -288,16 +295,13 @@ class Settings:
 
 
 def _parameter_rows(surface, values, functional, settings):
-    import logging
-
-    import numpy as np
-
-    from .. import metrology
-    from ..units import format_length
-
-    valid = int(np.count_nonzero(~np.isnan(surface.heights)))
-    extent = " × ".join(format_length(s) for s in surface.size)
-    basis = f"roughness at λc = {format_length(settings.cutoff)}" if settings.cutoff else "data as given, mean removed"
+    valid = int(surface.valid.sum())
+    extent = " × ".join(units.format_length(s) for s in surface.size)
+    basis = (
+        f"roughness at λc = {units.format_length(settings.cutoff)}"
+        if settings.cutoff
+        else "data as given, mean removed"
+    )
     if settings.along:
         basis += f", profiles along {settings.along}"
     profile = surface.is_profile or settings.along
@@ -323,10 +327,10 @@ def _parameter_rows(surface, values, functional, settings):
     else:
         evaluation["acf"] = settings.acf
     ratio_units = {"height": "m", "ratio": "%", "dc_ratios": "%", "volume_ratios": "%"}
-    units = {"points": "points", "valid_points": "points", "size": "m", "jrc_spacing": "m", "cutoff": "m"}
-    units["sampling_length"] = "m"
-    units |= {"material_ratio": ratio_units, "segmentation": {"pruning": "%", "threshold": "m"}}
-    rows = [("evaluation", evaluation, units, f"{extent}, {valid} of {surface.heights.size} points valid; {basis}")]
+    unit = {"points": "points", "valid_points": "points", "size": "m", "jrc_spacing": "m", "cutoff": "m"}
+    unit["sampling_length"] = "m"
+    unit |= {"material_ratio": ratio_units, "segmentation": {"pruning": "%", "threshold": "m"}}
+    rows = [("evaluation", evaluation, unit, f"{extent}, {valid} of {surface.heights.size} points valid; {basis}")]
     notes = _notes(surface, values, settings, sections)
     rows += _value_rows(values, metrology.PROFILE if profile else metrology.AREAL, notes)
     rows += _value_rows(functional, metrology.PROFILE_FUNCTIONAL if profile else metrology.AREAL_FUNCTIONAL, notes)
@@ -339,11 +343,9 @@ def _parameter_rows(surface, values, functional, settings):
 
 def _value_rows(values, table, notes=None):
     """A row per parameter of ``table`` (key: (unit, meaning)), its note in brackets."""
-    from ..units import format_quantity
-
     notes = notes or {}
     return [
-        (key, values[key], unit, f"{format_quantity(values[key], unit):<14} {meaning}" + _bracket(notes.get(key)))
+        (key, values[key], unit, f"{units.format_quantity(values[key], unit):<14} {meaning}" + _bracket(notes.get(key)))
         for key, (unit, meaning) in table.items()
     ]
 
@@ -354,16 +356,14 @@ def _bracket(note):
 
 def _sampling(surface, settings):
     """The sampling lengths of the profiles evaluated, as index ranges."""
-    from ..metrology.parameters import sampling_sections
-
     axis = 1 if settings.along == "y" else 0
-    return sampling_sections(surface.points[axis], surface.spacing[axis], settings.cutoff, settings.sampling_lengths)
+    return metrology.sampling_sections(
+        surface.points[axis], surface.spacing[axis], settings.cutoff, settings.sampling_lengths
+    )
 
 
 def _notes(surface, values, settings, sections):
-    from ..units import format_length
-
-    c = f"c = {format_length(settings.height)} about the mean"
+    c = f"c = {units.format_length(settings.height)} about the mean"
     mr = f"mr = {settings.ratio:g} %"
     dc = f"between {settings.dc_ratios[0]:g} % and {settings.dc_ratios[1]:g} %"
     pq = f"p = {settings.volume_ratios[0]:g} %, q = {settings.volume_ratios[1]:g} %"
@@ -372,7 +372,7 @@ def _notes(surface, values, settings, sections):
         "Rdq": f"{settings.slope} slope",
         "Sdq": f"{settings.slope} slope",
         "Sal": f"{settings.acf} autocorrelation",
-        "JRC": f"Z2 at {format_length(max(settings.jrc_spacing, surface.spacing[0]))} spacing",
+        "JRC": f"Z2 at {units.format_length(max(settings.jrc_spacing, surface.spacing[0]))} spacing",
         "Rmr": c,
         "Smr": c,
         "Rmc": mr,
@@ -397,21 +397,19 @@ def _sampling_length(surface, settings, sections):
 
 
 def _sampling_note(surface, settings, sections):
-    from ..units import format_length
-
     if sections is None:
         return None
     if settings.cutoff is None:
         return f"{len(sections)} sampling lengths"
-    return f"{len(sections)} sampling lengths of λc = {format_length(settings.cutoff)}"
+    return f"{len(sections)} sampling lengths of λc = {units.format_length(settings.cutoff)}"
 
 
 def _segmentation(pruning, edges, sz):
-    from ..units import format_length
-
     threshold = pruning / 100 * sz
     settings = {"pruning": pruning, "threshold": threshold, "edges": edges}
-    text = f"Wolf pruning at {pruning:g} % of Sz = {format_length(threshold)}; hills and dales at the edge {edges}d"
+    text = (
+        f"Wolf pruning at {pruning:g} % of Sz = {units.format_length(threshold)}; hills and dales at the edge {edges}d"
+    )
     return {"text": text, "settings": settings}
 
 
@@ -434,33 +432,27 @@ def _segment_table(hills, dales, pruning):
 
 
 def _detect(surface, cutoff, mode, polarity):
-    from ..errors import InputError
-    from ..metrology import detect_features
-    from ..units import format_length
-
     settings = {"cutoff": cutoff, "mode": mode, "polarity": polarity, "k": 2.0, "extension": 0.3}
     try:
-        found, info = detect_features(surface, cutoff=cutoff, mode=mode, polarity=polarity)
-    except InputError as error:
+        found, info = metrology.detect_features(surface, cutoff=cutoff, mode=mode, polarity=polarity)
+    except errors.InputError as error:
         return [], {"text": f"not detected ({error})", "settings": {**settings, "skipped": str(error)}}
     text = (
-        f"{len(found)} (mode {mode}, λc {format_length(cutoff)}, threshold 2·Rq_hf = "
-        f"{format_length(info['threshold'])}, +30 % lateral)"
+        f"{len(found)} (mode {mode}, λc {units.format_length(cutoff)}, threshold 2·Rq_hf = "
+        f"{units.format_length(info['threshold'])}, +30 % lateral)"
     )
     return found, {"text": text, "settings": {**settings, **info}}
 
 
 def _scaling_rows(scaling):
-    from ..units import format_length
-
     key = "Rq" if "Rq" in scaling else "Sq"
     rows = [
         (
             f"rq_vs_length.{key}.{index}",
             value,
             "m",
-            f"{format_length(value)} over {count} windows",
-            f"{key}(L={format_length(length)})",
+            f"{units.format_length(value)} over {count} windows",
+            f"{key}(L={units.format_length(length)})",
         )
         for index, (length, value, count) in enumerate(zip(scaling["length"], scaling[key], scaling["windows"]))
     ]

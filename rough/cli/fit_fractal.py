@@ -2,11 +2,13 @@
 
 import click
 
+from .. import fractal, io, plots, units
 from ..errors import InputError
 from .options import (
     BAND,
     DIRECTION,
     LENGTH,
+    RegistryChoice,
     crop_option,
     gaps_option,
     model_options,
@@ -16,10 +18,6 @@ from .options import (
 )
 from .report import Report, on_stdout, shown
 
-#: The names of rough.fractal.estimators.ESTIMATORS, kept here so that --help does not load
-#: numpy (tests/test_hurst_cli.py checks the two agree).
-ESTIMATOR_NAMES = ("whittle", "variogram", "dfa", "wavelet", "higuchi")
-
 
 @click.command("fit-fractal", short_help="Fractal dimension D and amplitude coefficient C, with uncertainty.")
 @surface_input
@@ -27,7 +25,7 @@ ESTIMATOR_NAMES = ("whittle", "variogram", "dfa", "wavelet", "higuchi")
 @click.option(
     "--band",
     type=BAND,
-    help="Fit band FMIN:FMAX in cycles per length, e.g. 0.1/mm:20/mm (bare numbers per mm; an empty end is open).",
+    help="Fit band FMIN:FMAX in cycles per length, e.g. 0.1/mm:20/mm (an empty end is open).",
 )
 @click.option("--resolution", type=LENGTH, help="The resolution η at which C is stated (default: the spacing).")
 @click.option(
@@ -40,7 +38,7 @@ ESTIMATOR_NAMES = ("whittle", "variogram", "dfa", "wavelet", "higuchi")
 @gaps_option
 @click.option(
     "--estimator",
-    type=click.Choice([*ESTIMATOR_NAMES, "all"]),
+    type=RegistryChoice(lambda: [*fractal.ESTIMATOR_NAMES, "all"]),
     help="H by this estimator of profiles (or all side by side), calibrated on exact fBm of the data's "
     "size, sampling, gaps and noise: bias-corrected H with a 95 % interval, and the raw value.",
 )
@@ -59,7 +57,7 @@ ESTIMATOR_NAMES = ("whittle", "variogram", "dfa", "wavelet", "higuchi")
 )
 @click.option(
     "--sampling",
-    type=click.Choice(["point", "band-limited"]),
+    type=RegistryChoice(lambda: fractal.SAMPLINGS),
     help="Point samples (power above Nyquist folds back) or band-limited data; by default band-limited "
     "when rough synthesised or resampled the surface, point samples otherwise.",
 )
@@ -125,11 +123,9 @@ def fit_fractal(
         rough fit-fractal --profiles x --estimator all fault.npz
         rough fit-fractal --band 0.05/mm:5/mm --resolution 0.0309mm --psd psd.tsv --plot psd.png scan.x3p
     """
-    from ..fractal.resample import fill_invalid
-
     report = not on_stdout(psd=psd_file, plot=plot)
     if fill:
-        surface = fill_invalid(surface)
+        surface = fractal.fill_invalid(surface)
     model = {"band": band, "resolution": resolution, "sampling": sampling, "noise": noise, "rolloff": rolloff}
     model.update(level=level, order=order, tip_radius=tip_radius)
     if estimator or direction is not None:
@@ -138,11 +134,8 @@ def fit_fractal(
         if estimator:
             return _estimators_report(surface, direction, gaps, estimator, replicates, seed, model)
         return _profiles_report(surface, input, direction, gaps, model, psd_file, plot, report)
-    from ..fractal.fit import fit_fractal as fit
-    from ..fractal.psd import binned_spectrum
-
-    result = fit(surface, **model)
-    spectrum = binned_spectrum(surface, order) if (psd_file or plot or surface.is_profile) else None
+    result = fractal.fit_fractal(surface, **model)
+    spectrum = fractal.binned_spectrum(surface, order) if (psd_file or plot or surface.is_profile) else None
     document = {**result.as_dict(), "points": surface.heights.size}
     if spectrum and "parseval" in spectrum:
         document["parseval"] = spectrum["parseval"]
@@ -150,8 +143,6 @@ def fit_fractal(
         what, unit = ("Hann periodogram G", "m3") if surface.is_profile else ("ring-averaged P2", "m4")
         _write_psd(psd_file, spectrum, what, unit)
     if plot and result.scale_dependent:
-        from .. import plots
-
         title = f"{_title(input, surface)}: no power-law band"
         plots.save(plots.scale_dependent_figure(result.scale_dependent, title, result.reliability_cutoff), plot)
     elif plot:
@@ -162,14 +153,11 @@ def fit_fractal(
 def _profiles_report(surface, input, direction, gaps, model, psd_file, plot, report):
     """The pooled Whittle fit of the profiles along ``direction``; ``--psd`` writes and
     ``--plot`` draws their mean spectrum with the per-profile spread."""
-    from ..fractal.profiles import fit_profiles
-    from ..fractal.psd import profile_spectrum
-
-    result = fit_profiles(surface, direction, gaps, **model)
+    result = fractal.fit_profiles(surface, direction, gaps, **model)
     document = result.as_dict()
     if psd_file or plot:
         profiles = result.profile_set
-        spectrum = profile_spectrum(profiles.heights, profiles.spacing)
+        spectrum = fractal.profile_spectrum(profiles.heights, profiles.spacing)
         if psd_file:
             _write_psd(
                 psd_file,
@@ -192,11 +180,9 @@ def _estimators_report(surface, direction, gaps, estimator, replicates, seed, mo
     """The calibrated H of the profiles along ``direction`` by one estimator or all."""
     if direction is None and not surface.is_profile:
         raise InputError("--estimator measures H of profiles: give --profiles x, y or an angle for a map")
-    from ..fractal.hurst import hurst_exponents
-
     direction = "x" if direction is None else direction
     names = None if estimator == "all" else [estimator]
-    table = hurst_exponents(surface, direction, names, gaps, replicates=replicates, seed=seed, **model)
+    table = fractal.hurst_exponents(surface, direction, names, gaps, replicates=replicates, seed=seed, **model)
     document = table.as_dict()
     replaced = {"fractal_dimension", "fractal_dimension_stderr", "hurst"}
     whittle = [row for row in _rows(table.profile_fit.fit, True, document) if row[0] not in replaced]
@@ -206,22 +192,16 @@ def _estimators_report(surface, direction, gaps, estimator, replicates, seed, mo
 def _write_psd(path, spectrum, what, unit="m3", extra=()):
     """The log-binned spectrum as TSV: frequency (1/m), density (``unit``), count, and
     ``extra`` columns."""
-    from ..io.atomic import atomic_output
-
     columns = ["frequency_per_m", f"density_{unit}", "count", *extra]
     keys = ["frequency", "density", "count", *("log_spread" if name == "log10_spread" else name for name in extra)]
     lines = [f"# rough fit-fractal: log-binned spectrum ({what})", "\t".join(columns)]
     lines += ["\t".join(repr(value) for value in row) for row in zip(*(spectrum[key] for key in keys))]
-    with atomic_output(path) as stream:
+    with io.atomic_output(path) as stream:
         stream.write(("\n".join(lines) + "\n").encode())
 
 
 def _plot_spectrum(plot, spectrum, fit, spacing, title):
-    import numpy as np
-
-    from .. import plots
-
-    figure = plots.spectrum_figure(np.array(spectrum["frequency"]), np.array(spectrum["density"]), fit, spacing, title)
+    figure = plots.spectrum_figure(spectrum["frequency"], spectrum["density"], fit, spacing, title)
     plots.save(figure, plot)
 
 
@@ -232,8 +212,6 @@ def _title(input, surface):
 
 
 def _rows(result, is_profile, document):
-    from ..units import format_length
-
     key = "D" if is_profile else "Ds"
     if result.verdict == "no power-law range":
         return [
@@ -269,15 +247,15 @@ def _rows(result, is_profile, document):
                 f"D = Ds - 1 = {result.profile_dimension:.4f} (profiles through the map)",
             )
         )
-    amplitude = format_length(result.amplitude_coefficient)
+    amplitude = units.format_length(result.amplitude_coefficient)
     if not result.at_bound:
-        amplitude += f" ± {format_length(result.amplitude_coefficient_stderr)}"
+        amplitude += f" ± {units.format_length(result.amplitude_coefficient_stderr)}"
     rows += [
         (
             "amplitude_coefficient",
             result.amplitude_coefficient,
             "m",
-            f"C = {amplitude} at η = {format_length(result.resolution)}",
+            f"C = {amplitude} at η = {units.format_length(result.resolution)}",
         ),
         (
             "amplitude_coefficient_stderr",
@@ -285,9 +263,9 @@ def _rows(result, is_profile, document):
             "m",
             "none: a bound has no standard error"
             if result.amplitude_coefficient_stderr is None
-            else f"{format_length(result.amplitude_coefficient_stderr)} (standard error of C)",
+            else f"{units.format_length(result.amplitude_coefficient_stderr)} (standard error of C)",
         ),
-        ("resolution", result.resolution, "m", f"η = {format_length(result.resolution)} (C is stated at it)"),
+        ("resolution", result.resolution, "m", f"η = {units.format_length(result.resolution)} (C is stated at it)"),
         (
             "psd_prefactor",
             result.psd_prefactor,
@@ -299,7 +277,7 @@ def _rows(result, is_profile, document):
             "structure_function_coefficient",
             result.structure_function_coefficient,
             "m",
-            f"{format_length(result.structure_function_coefficient)} (Ganti & Bhushan's C_S at η)",
+            f"{units.format_length(result.structure_function_coefficient)} (Ganti & Bhushan's C_S at η)",
         ),
         ("band", list(result.band), "1/m", _band_text(result.band, "scaling range")),
         (
@@ -314,7 +292,12 @@ def _rows(result, is_profile, document):
     rows.append(("noise_rms", result.noise_rms, "m", _noise_text(result)))
     if result.rolloff_wavelength:
         rows.append(
-            ("rolloff_wavelength", result.rolloff_wavelength, "m", f"{format_length(result.rolloff_wavelength)} (1/fc)")
+            (
+                "rolloff_wavelength",
+                result.rolloff_wavelength,
+                "m",
+                f"{units.format_length(result.rolloff_wavelength)} (1/fc)",
+            )
         )
     rows += _cutoff_rows(result)
     rows.append(_method_row(result))
@@ -330,8 +313,6 @@ SCALE_UNITS = {"scale": "m", "rms_height": "m", "rms_slope": "1", "rms_curvature
 
 def _scale_rows(table):
     """The scale-dependent roughness: one row holding the table, then a line per scale."""
-    from ..units import format_length, format_quantity
-
     rows = [
         (
             "scale_dependent",
@@ -343,17 +324,15 @@ def _scale_rows(table):
     for scale, height, slope, curvature in zip(
         table["scale"], table["rms_height"], table["rms_slope"], table["rms_curvature"]
     ):
-        text = f"{format_length(height):>12}  {slope:10.4g}  {format_quantity(curvature, '1/m'):>14}"
-        rows.append((None, None, None, text, f"λ = {format_length(scale)}"))
+        text = f"{units.format_length(height):>12}  {slope:10.4g}  {units.format_quantity(curvature, '1/m'):>14}"
+        rows.append((None, None, None, text, f"λ = {units.format_length(scale)}"))
     return rows
 
 
 def _cutoff_rows(result):
-    from ..units import format_length
-
     if result.reliability_cutoff is None:
         return []
-    text = f"{format_length(result.reliability_cutoff)}: shorter wavelengths left out (the tip cannot follow)"
+    text = f"{units.format_length(result.reliability_cutoff)}: shorter wavelengths left out (the tip cannot follow)"
     return [("reliability_cutoff", result.reliability_cutoff, "m", text)]
 
 
@@ -364,18 +343,14 @@ def _dimension_text(result, key):
 
 
 def _band_text(band, what):
-    from ..units import format_length
-
     low, high = band
     return (
-        f"{low * 1e-3:.4g} to {high * 1e-3:.4g} /mm (wavelengths {format_length(1 / high)} to "
-        f"{format_length(1 / low)}), {what}"
+        f"{low * 1e-3:.4g} to {high * 1e-3:.4g} /mm (wavelengths {units.format_length(1 / high)} to "
+        f"{units.format_length(1 / low)}), {what}"
     )
 
 
 def _noise_text(result):
-    from ..units import format_length
-
     if result.noise_rms is None:
         return "no white noise floor found"
     crossing = (
@@ -383,7 +358,7 @@ def _noise_text(result):
         if result.noise_crossover
         else ", below the power law throughout the band"
     )
-    return f"{format_length(result.noise_rms)} RMS white noise floor{crossing}"
+    return f"{units.format_length(result.noise_rms)} RMS white noise floor{crossing}"
 
 
 def _method_row(result):
@@ -445,8 +420,6 @@ def _angle_text(angle):
 
 def _estimator_rows(table, document):
     """One row per estimator: the calibrated H, its 95 % interval, the raw value, the bias."""
-    from ..units import format_length
-
     rows = [(None, None, None, "H (calibrated)  95 % interval   raw H    bias", "estimators")]
     for index, (estimate, record) in enumerate(zip(table.estimates, document["estimators"])):
         low, high = estimate.interval
@@ -469,7 +442,7 @@ def _estimator_rows(table, document):
     whittle = (
         "the Whittle fit found no power-law band"
         if scales is None
-        else f"the Whittle fit's band: wavelengths {format_length(scales[0])} to {format_length(scales[1])}"
+        else f"the Whittle fit's band: wavelengths {units.format_length(scales[0])} to {units.format_length(scales[1])}"
     )
     rows.append(
         (

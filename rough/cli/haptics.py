@@ -4,13 +4,14 @@ check."""
 
 import dataclasses
 import functools
+import logging
 
 import click
 
+from .. import extras, render
 from .options import SPACING, QuantityType
 
 MAX_RATE = 100e3  # Hz: a Python tick takes a few microseconds; no device or model needs more
-BACKEND_MODULES = {"hid": ("hidraw", "hidtools"), "evdev": ("evdev",)}  # the extras each device needs
 
 
 class PositiveQuantity(QuantityType):
@@ -33,6 +34,27 @@ MASS, SPEED, TIME, RATE = (
 )
 MAX_FORCE = PositiveQuantity("force", "N")
 RAMP = QuantityType("time", "s")
+
+
+class DeviceOption(click.Option):
+    """``--device``, whose forms and help come from the registry of devices
+    (:func:`rough.render.backends`, plugins included) when the help is shown."""
+
+    @property
+    def metavar(self):
+        return "|".join(backend.form for backend in render.backends().values())
+
+    @metavar.setter
+    def metavar(self, value):
+        pass
+
+    @property
+    def help(self):
+        return f"{render.descriptions()}. After the colon: which one (default: the first found)."
+
+    @help.setter
+    def help(self, value):
+        pass
 
 
 class CouplingType(click.ParamType):
@@ -72,41 +94,31 @@ class Haptics:
 
     @property
     def simulated(self):
-        from ..render.device import is_simulated
-
-        return is_simulated(self.device)
+        return render.is_simulated(self.device)
 
     def contact(self):
         """The profile's contact model, behind the virtual coupling if one was asked for."""
-        from ..render.session import make_model
-
-        model = make_model(self.model, self.stiffness, self.mass, self.damping, 1.0 / self.rate)
+        model = render.make_model(self.model, self.stiffness, self.mass, self.damping, 1.0 / self.rate)
         if self.coupling is None:
             return model
-        from ..render.stability import VirtualCoupling
-
         if self.model != "quasi-static":
             raise click.BadParameter("the virtual coupling wraps the quasi-static model", param_hint="--coupling")
-        return VirtualCoupling(model, *self.coupling, period=1.0 / self.rate)
+        return render.VirtualCoupling(model, *self.coupling, period=1.0 / self.rate)
 
     def field(self, load):
         """The map's gradient field with the normal load ``load`` (N)."""
-        from ..render.contact import GradientField
-
         if self.model != "quasi-static" or self.coupling is not None:
             raise click.BadParameter(
                 "a map is felt through the lateral gradient field; --model dynamic and --coupling apply to profiles",
                 param_hint="--model/--coupling",
             )
-        return GradientField(load)
+        return render.GradientField(load)
 
     def device_model(self, contact, load, device):
         """``contact`` as the open ``device`` renders it (a wheel feels a profile's
         lateral force alone, with the normal load ``load``, N), checked against the
         passivity bound when it is a contact model."""
-        from ..render.session import fitted_model
-
-        model = fitted_model(contact, device, load)
+        model = render.fitted_model(contact, device, load)
         if model is contact and hasattr(contact, "stiffness"):
             self.warn_if_unstable()
         return model
@@ -115,25 +127,17 @@ class Haptics:
         """Log one warning when the contact stiffness exceeds the passivity bound at
         this rate for a device of damping ``damping`` (N·s/m; default
         ``--device-damping``) and no coupling holds it."""
-        import logging
-
-        from ..render.stability import stability_warning
-
         b = self.device_damping if damping is None else damping
-        message = stability_warning(self.stiffness, self.rate, b, self.coupling)
+        message = render.stability_warning(self.stiffness, self.rate, b, self.coupling)
         if message:
             logging.getLogger("rough").warning(message)
 
     def friction_model(self):
-        from ..render.friction import parse_friction
-
-        return parse_friction(self.friction)
+        return render.parse_friction(self.friction)
 
     def settings(self, duration=None, realtime=False):
-        from ..render import Settings
-
         ramp = self.ramp if self.ramp is not None else (0.0 if self.simulated else 0.5)
-        return Settings(
+        return render.Settings(
             rate=self.rate,
             duration=duration,
             max_force=self.max_force,
@@ -151,27 +155,21 @@ def haptic_options(command):
 
     @functools.wraps(command)
     def wrapper(*args, **kwargs):
-        from ..extras import require
-        from ..render.device import DeviceError, parse_device
-
         values = {name: kwargs.pop(name) for name in names}
         try:
-            backend, _ = parse_device(values["device"])
-        except DeviceError as error:
+            backend, _ = render.parse_device(values["device"])
+        except render.DeviceError as error:
             raise click.BadParameter(str(error).partition(": ")[2], param_hint="--device") from None
-        for module in BACKEND_MODULES.get(backend, ()):
-            require(module)
+        for module in render.backends()[backend].requires:
+            extras.require(module)
         return command(*args, haptics=Haptics(**values), **kwargs)
 
     options = [
         click.option(
             "--device",
+            cls=DeviceOption,
             default="sim",
             show_default=True,
-            metavar="sim|hid[:VID:PID]|evdev[:PATH]",
-            help="sim: a simulated hand; hid: the first HID PID force-feedback joystick through hidraw (or the "
-            "one with these hex IDs); evdev: the first Linux force-feedback device (or /dev/input/eventN), "
-            "through its kernel driver.",
         ),
         click.option("--rate", type=RATE, default="1kHz", show_default=True, help="Servo rate."),
         click.option(

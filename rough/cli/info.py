@@ -2,6 +2,7 @@
 
 import click
 
+from .. import io, metrology, units
 from .options import report_format, surface_input
 from .report import Report
 
@@ -24,17 +25,13 @@ def info(surface, input):
         rough info --json scan.x3p | jq .spacing
         rough info --tsv a.x3p b.x3p c.x3p > inventory.tsv
     """
-    from ..io import describe
-    from ..summary import summary
-    from ..units import format_length
-
-    facts = summary(surface)
+    facts = metrology.summary(surface)
     document = {"format": surface.source_format, **facts}
     x_by_y = " × ".join
     rms_key = "Rq" if surface.is_profile else "Sq"
     digits = _digits(facts["z_min"], facts["z_max"])
     rows = [
-        ("format", surface.source_format, "", describe(surface.source_format)),
+        ("format", surface.source_format, "", io.describe(surface.source_format)),
         ("kind", facts["kind"], "", facts["kind"]),
         (
             "shape",
@@ -42,9 +39,9 @@ def info(surface, input):
             "points",
             f"{x_by_y(map(str, facts['shape']))} points" + ("" if surface.is_profile else " (x × y)"),
         ),
-        ("spacing", facts["spacing"], "m", x_by_y(format_length(d) for d in facts["spacing"])),
-        ("size", facts["size"], "m", x_by_y(format_length(s) for s in facts["size"])),
-        ("origin", facts["origin"], "m", ", ".join(format_length(o) for o in facts["origin"])),
+        ("spacing", facts["spacing"], "m", x_by_y(units.format_length(d) for d in facts["spacing"])),
+        ("size", facts["size"], "m", x_by_y(units.format_length(s) for s in facts["size"])),
+        ("origin", facts["origin"], "m", ", ".join(units.format_length(o) for o in facts["origin"])),
         (
             "valid_points",
             facts["valid_points"],
@@ -62,19 +59,15 @@ def info(surface, input):
 
 
 def _length(value, digits=5):
-    from ..units import format_length
-
-    return "none (no valid points)" if value is None else format_length(value, digits)
+    return "none (no valid points)" if value is None else units.format_length(value, digits)
 
 
 def _digits(low, high):
     """Significant digits that tell ``low`` from ``high`` (a 4 µm range at 106 mm
     needs eight)."""
-    from ..units import digits_for
-
     if low is None or high is None:
         return 5
-    return digits_for(max(abs(low), abs(high)), (high - low) / 100)
+    return units.digits_for(max(abs(low), abs(high)), (high - low) / 100)
 
 
 def _history_line(entry):

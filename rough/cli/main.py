@@ -1,7 +1,10 @@
 """The ``rough`` command: a click group with one small module per subcommand.
 
-Subcommand modules are imported only when needed, and they import the library only
-inside their functions, so ``rough --help`` starts without numpy. Errors end in one
+:data:`COMMANDS` is the registry of built-in subcommands; a package adds one through
+the entry-point group ``rough.commands`` (:func:`rough.plugins.entry_points`). A
+subcommand's module is imported only when it is needed, and imports the library's
+packages, which load their modules on first use, so ``rough --help`` starts without
+numpy. Errors end in one
 line on stderr (``rough COMMAND: FILE: problem``) and an exit status: 0 success, 2 bad
 usage or bad input, 1 any other failure, 130 interrupted (Ctrl-C), 143 terminated
 (SIGTERM), 129 hung up (SIGHUP); a closed downstream pipe ends the command quietly
@@ -15,12 +18,16 @@ import logging
 import os
 import signal
 import sys
+import traceback
 import warnings
 
 import click
 
-from .. import __version__
+from .. import __version__, errors, plugins, progress
+from . import overview_cache
+from .report import printable
 
+#: The built-in subcommands: name -> ``module:attribute`` of a click command.
 COMMANDS = {
     "info": "rough.cli.info:info",
     "convert": "rough.cli.convert:convert",
@@ -78,19 +85,55 @@ class LazyGroup(click.Group):
         except KeyboardInterrupt as error:  # past click, which would print a blank line first
             raise Interrupted() from error
 
+    def get_help(self, ctx):
+        text = super().get_help(ctx)
+        overview_cache.store_overview(f"{text}\n")  # as click.echo prints it
+        return text
+
     def list_commands(self, ctx):
-        return sorted(COMMANDS)
+        return sorted({*COMMANDS, *plugins.entry_points("rough.commands")})
 
     def get_command(self, ctx, name):
-        if name not in COMMANDS:
+        if name in COMMANDS:
+            return _load(COMMANDS[name])
+        plugin = plugins.entry_points("rough.commands").get(name)
+        if plugin is None:
             return None
-        module, attribute = COMMANDS[name].split(":")
-        return getattr(importlib.import_module(module), attribute)
+        try:
+            command = _load(plugin)
+        except Exception as error:  # noqa: BLE001 -- any failure of a plugin's import leaves the rest working
+            return BrokenCommand(name, plugin, f"{type(error).__name__}: {error}")
+        if not isinstance(command, click.Command):
+            return BrokenCommand(name, plugin, f"{type(command).__name__} is not a click command")
+        return command
 
     def resolve_command(self, ctx, args):
         name, command, rest = super().resolve_command(ctx, args)
         _invoked.append(name)
         return name, command, rest
+
+
+def _load(value):
+    """The object that ``module:attribute`` names."""
+    module, _, attribute = value.partition(":")
+    return getattr(importlib.import_module(module), attribute)
+
+
+class BrokenCommand(click.Command):
+    """A plugin's subcommand that could not be loaded (as rasterio's ``BrokenCommand``):
+    listed in ``rough --help`` as broken; run, it says why in one line and exits 1."""
+
+    def __init__(self, name, value, reason):
+        super().__init__(
+            name,
+            short_help=f"(broken plugin {value}: run it to see why)",
+            add_help_option=False,
+            context_settings={"ignore_unknown_options": True, "allow_extra_args": True},
+        )
+        self.reason = f"the plugin {value} cannot be loaded: {reason}"
+
+    def invoke(self, ctx):
+        raise click.ClickException(self.reason)
 
 
 @click.group(cls=LazyGroup, context_settings={"help_option_names": ["-h", "--help"]})
@@ -109,11 +152,10 @@ def cli(quiet, verbose, debug):
         cat scan.x3p | rough info
         rough info --json scan.x3p | jq .valid_points
 
-    Lengths take a unit (0.1545mm, 30.9um, 2e-3m); a bare number is in mm.
-    Invalid points are NaN throughout.
+    Lengths, frequencies and forces name their unit (0.1545mm, 30.9um, 0.2/mm,
+    1N); a number in a file that names no unit is in metres. Invalid points are NaN
+    throughout.
     """
-    from .. import progress
-
     level = logging.ERROR if quiet else (logging.WARNING, logging.INFO, logging.DEBUG)[min(verbose, 2)]
     handler = logging.StreamHandler(sys.stderr) if sys.stderr else logging.NullHandler()
     handler.setFormatter(_Formatter())
@@ -131,8 +173,6 @@ def _warn_in_one_line(message, category, filename, lineno, file=None, line=None)
 
 class _Formatter(logging.Formatter):
     def format(self, record):
-        from .report import printable
-
         kind = "warning: " if record.levelno >= logging.WARNING else ""
         return printable(f"{_prefix()}: {kind}{record.getMessage()}")
 
@@ -213,13 +253,9 @@ def _run(args):
 def failure(error, debug=None):
     """``(message, exit status)`` for an exception that ends a command (or, with several
     inputs, one input's work); with ``debug`` the traceback goes to standard error."""
-    from ..errors import RoughError
-
     if _debug[0] if debug is None else debug:
-        import traceback
-
         traceback.print_exception(error, file=sys.stderr)
-    if isinstance(error, RoughError):
+    if isinstance(error, errors.RoughError):
         return str(error), error.exit_code
     if isinstance(error, MemoryError):
         return "out of memory: the surface is too large for this machine (crop it, or resample it coarser)", 1
@@ -231,8 +267,6 @@ def failure(error, debug=None):
 
 def say(message):
     """Print ``rough COMMAND: message`` on standard error."""
-    from .report import printable
-
     if sys.stderr is None:  # closed: the message is lost, but never sent to standard output
         return
     try:

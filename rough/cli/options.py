@@ -5,7 +5,12 @@ command once per input with a :class:`~rough.Surface` (``input_options(flag)`` n
 the input-spacing option otherwise, for commands whose own ``--spacing`` is an
 output); ``surface_output`` adds ``-o/--output`` and ``-f/--format`` and hands it an
 :class:`Output` that writes a surface there; ``report_format`` adds
-``--json``/``--tsv``. Lengths take a unit; a bare number is in mm.
+``--json``/``--tsv``; ``renamed`` keeps an option's old name working for a release.
+
+Lengths, frequencies and physical quantities name their unit (``0.1545mm``,
+``0.2/mm``, ``20mm/s``); zero needs none. rough 0.12 still reads a bare number in the
+option's old default unit (mm, per mm, the quantity's), with a one-line warning
+(:func:`bare_number`); rough 0.13 refuses it.
 
 Every number an option takes is range-checked here, by its type: it must be finite
 (NaN and infinities refused), positive where the option says so, and of a plausible
@@ -17,10 +22,21 @@ than exists. A new option gets these checks by using these types
 
 import dataclasses
 import functools
+import logging
 import math
+import os
 import sys
 
 import click
+from click.shell_completion import CompletionItem
+
+from .. import errors, extras, fractal, io, metrology, units
+from ..io import registry
+from .batch import check_inputs, read_named, run_each, stem_name
+
+log = logging.getLogger("rough")
+#: The release that refuses what 0.12 still takes with a warning.
+REFUSED_FROM = "0.13"
 
 #: The smallest and largest length (metres) an option takes: 1 pm (below an atom's
 #: size) and 10 000 km (a planet's elevation model, a UTM northing); zero where an
@@ -52,9 +68,57 @@ def _refuse_outside(type_, number, bounds, value, param, ctx, what, show, zero=F
 
 
 def _length(metres):
-    from ..units import format_length
+    return units.format_length(metres, 6)
 
-    return format_length(metres, 6)
+
+def bare_number(value, flag, unit):
+    """Warn, once per option ``flag``, that ``value`` is a bare number read in the
+    option's old default ``unit`` (rough 0.12; zero needs no unit)."""
+    if flag is not None and flag not in _warned and units.is_bare(value) and float(value) != 0:
+        _warned.add(flag)
+        log.warning(
+            f"{flag} {value.strip()}: a bare number is read as {value.strip()} {unit}; write the unit "
+            f"(bare numbers are refused from rough {REFUSED_FROM})"
+        )
+
+
+def _flag(param):
+    """The option's longest name, as people type it (None for no option)."""
+    return param.opts[-1] if param is not None and param.opts else None
+
+
+_warned = set()
+
+
+def renamed(old, new, name, type=None, required=False):
+    """A hidden alias ``old`` (a flag, or a tuple of them) of the option ``new``, whose
+    keyword is ``name``: it works until rough 0.13, with a one-line warning. With
+    ``required``, one of the two must be given (put it above ``input_options``, so that
+    this is checked before any input is read)."""
+    old = (old,) if isinstance(old, str) else old
+
+    def warn(ctx, param, value):
+        if value is not None:
+            log.warning(f"{'/'.join(old)} is deprecated (rough 0.12): use {new}; it goes in {REFUSED_FROM}")
+        return value
+
+    def decorate(command):
+        @functools.wraps(command)
+        def wrapper(*args, **kwargs):
+            value = kwargs.pop(f"deprecated_{name}")
+            if value is not None:
+                if click.get_current_context().get_parameter_source(name) == click.core.ParameterSource.COMMANDLINE:
+                    raise click.UsageError(f"give {new}, not {'/'.join(old)} too")
+                kwargs[name] = value
+            elif required and kwargs.get(name) is None:
+                context = click.get_current_context()
+                option = next(param for param in context.command.params if param.name == name)
+                raise click.MissingParameter(ctx=context, param=option)
+            return command(*args, **kwargs)
+
+        return click.option(*old, f"deprecated_{name}", type=type, hidden=True, callback=warn)(wrapper)
+
+    return decorate
 
 
 class FloatRange(click.FloatRange):
@@ -73,9 +137,7 @@ def plot_option(help):
 
     def needs_matplotlib(ctx, param, value):
         if value is not None:
-            from ..extras import require
-
-            require("matplotlib")
+            extras.require("matplotlib")
         return value
 
     return click.option("--plot", metavar="FILE", callback=needs_matplotlib, help=help)
@@ -90,14 +152,13 @@ class LengthType(click.ParamType):
     def convert(self, value, param, ctx):
         if isinstance(value, float):
             return value
-        from ..errors import InputError
-        from ..units import parse_length
-
         try:
-            length = parse_length(value)
-        except InputError as error:
+            length = units.parse_length(value, "mm")
+        except errors.InputError as error:
             self.fail(str(error), param, ctx)
-        return self.checked(length, value, param, ctx)
+        length = self.checked(length, value, param, ctx)
+        bare_number(value, _flag(param), "mm")  # after the checks: a refused value is one line
+        return length
 
     def checked(self, length, value, param, ctx):
         """``length`` if it is in this type's range; a failure otherwise."""
@@ -135,7 +196,7 @@ class SpacingType(PositiveLengthType):
 
 class QuantityType(click.ParamType):
     """A physical quantity with a unit (``1.28N/mm``, ``20mm/s``, ``1.85g``) → SI; a
-    bare number is in ``default_unit``. Zero (unless ``positive``) or a magnitude within
+    bare number is in ``default_unit``, with a warning (rough 0.12). Zero (unless ``positive``) or a magnitude within
     :data:`QUANTITIES` for its kind (and at most ``most``, if given)."""
 
     def __init__(self, kind, default_unit, positive=False, most=None):
@@ -146,42 +207,40 @@ class QuantityType(click.ParamType):
     def convert(self, value, param, ctx):
         if isinstance(value, float):
             return value
-        from ..errors import InputError
-        from ..units import parse_quantity
-
         try:
-            quantity = parse_quantity(value, self.kind, self.default_unit)
-        except InputError as error:
+            quantity = units.parse_quantity(value, self.kind, self.default_unit)
+        except errors.InputError as error:
             self.fail(str(error), param, ctx)
         if quantity < 0:
             self.fail(f"{value!r}: must not be negative", param, ctx)
         what = f"a {self.kind}"
-        return _refuse_outside(self, quantity, self.bounds, value, param, ctx, what, self.show, not self.positive)
+        quantity = _refuse_outside(self, quantity, self.bounds, value, param, ctx, what, self.show, not self.positive)
+        bare_number(value, _flag(param), self.default_unit.replace("*", "·"))
+        return quantity
 
     def show(self, quantity):
         """``quantity`` (SI) in this option's unit."""
-        from ..units import format_unit
+        return units.format_unit(quantity, self.kind, 6)
 
-        return format_unit(quantity, self.kind, 6)
+
+#: The names of rough.metrology.PRESETS (the tip presets), kept here so that --help does
+#: not load numpy (tests/test_option_ranges.py checks the two agree).
+TIP_PRESETS = ("needle", "fingernail", "fingertip")
 
 
 class TipType(PositiveLengthType):
-    """A tip radius: a length, or a preset (``needle`` 0.05 mm, ``fingernail`` 0.5 mm,
-    ``fingertip`` 8 mm) → metres."""
+    """A tip radius: a length, or a preset of :data:`rough.metrology.PRESETS`
+    (``needle`` 0.05 mm, ``fingernail`` 0.5 mm, ``fingertip`` 8 mm) → metres."""
 
-    name = "RADIUS|needle|fingernail|fingertip"
+    name = "|".join(("RADIUS", *TIP_PRESETS))
     what = "a tip radius"
 
     def shell_complete(self, ctx, param, incomplete):
-        from click.shell_completion import CompletionItem
-
-        return [CompletionItem(name) for name in ("needle", "fingernail", "fingertip") if name.startswith(incomplete)]
+        return [CompletionItem(name) for name in TIP_PRESETS if name.startswith(incomplete)]
 
     def convert(self, value, param, ctx):
-        from ..metrology.tip import PRESETS
-
-        if isinstance(value, str) and value.strip().lower() in PRESETS:
-            return PRESETS[value.strip().lower()]
+        if isinstance(value, str) and value.strip().lower() in TIP_PRESETS:
+            return metrology.PRESETS[value.strip().lower()]
         return super().convert(value, param, ctx)
 
 
@@ -231,23 +290,20 @@ class CropType(click.ParamType):
 
 
 class FrequencyRangeType(click.ParamType):
-    """``FMIN:FMAX`` spatial frequencies (``0.1/mm:20/mm``; a bare number is per mm;
-    an empty end is open) → (fmin or None, fmax or None) in 1/m."""
+    """``FMIN:FMAX`` spatial frequencies (``0.1/mm:20/mm``; an empty end is open) →
+    (fmin or None, fmax or None) in 1/m. A bare number is per mm, with a warning (rough 0.12)."""
 
     name = "FMIN:FMAX"
 
     def convert(self, value, param, ctx):
         if isinstance(value, tuple):
             return value
-        from ..errors import InputError
-        from ..units import parse_frequency
-
         ends = str(value).split(":")
         if len(ends) != 2:
             self.fail(f"{value!r}: write a band as FMIN:FMAX, e.g. 0.1/mm:20/mm", param, ctx)
         try:
-            low, high = (None if not end.strip() else parse_frequency(end) for end in ends)
-        except InputError as error:
+            low, high = (None if not end.strip() else units.parse_frequency(end, "mm") for end in ends)
+        except errors.InputError as error:
             self.fail(str(error), param, ctx)
         if any(end is not None and end <= 0 for end in (low, high)):
             self.fail(f"{value!r}: frequencies must be positive", param, ctx)
@@ -257,6 +313,8 @@ class FrequencyRangeType(click.ParamType):
                 _refuse_outside(self, end, bounds, value, param, ctx, "a frequency", lambda f: f"{f * 1e-3:.6g}/mm")
         if low is not None and high is not None and low >= high:
             self.fail(f"{value!r}: FMIN must be below FMAX, e.g. 0.05/mm:5/mm", param, ctx)
+        for end in ends:
+            bare_number(end, _flag(param), "/mm")
         return low, high
 
 
@@ -321,7 +379,7 @@ def gaps_option(command):
     """``--gaps longest|fill``: how profiles taken from a map treat its invalid points."""
     return click.option(
         "--gaps",
-        type=click.Choice(["longest", "fill"]),
+        type=RegistryChoice(lambda: fractal.GAPS),
         default="longest",
         show_default=True,
         help="With --profiles: keep each profile's longest run of valid points, or fill its gaps linearly.",
@@ -387,8 +445,6 @@ def input_options(spacing_flag="--spacing", together=None):
     def decorate(command):
         @functools.wraps(command)
         def wrapper(*args, input, spacing, unit, ignore_checksums, channel, layer, regrid, **kwargs):
-            from .batch import read_named, run_each
-
             options = dict(
                 spacing=spacing,
                 unit=unit,
@@ -452,8 +508,6 @@ def input_options(spacing_flag="--spacing", together=None):
 def _together(command, names, options, most, kwargs):
     """Inputs that one run uses together (render's surfaces, switched by the trigger):
     one report, under the first input's name."""
-    from .batch import check_inputs, read_named, run_each
-
     if len(names) > most:
         raise click.UsageError(f"give at most {most} inputs, not {len(names)}")
     check_inputs(names)
@@ -467,18 +521,17 @@ def _together(command, names, options, most, kwargs):
 surface_input = input_options()
 
 
-class _WritableFormats(click.Choice):
-    """The formats rough writes, looked up in the registry when first needed, so that
-    ``rough --help`` starts without importing the readers."""
+class RegistryChoice(click.Choice):
+    """A choice among the names of a registry of the library, ``names()``, read when
+    first needed: the library's modules load numpy (and a registry with plugins scans
+    the installed packages), which ``rough --help`` must not."""
 
-    def __init__(self):
-        self.case_sensitive = True
+    def __init__(self, names):
+        self.names, self.case_sensitive = names, True
 
     @functools.cached_property
     def choices(self):
-        from ..io.registry import writable
-
-        return tuple(writable())
+        return tuple(self.names())
 
 
 def surface_output(command):
@@ -494,7 +547,7 @@ def surface_output(command):
     wrapper = click.option(
         "-f",
         "--format",
-        type=_WritableFormats(),
+        type=RegistryChoice(registry.writable),
         default=None,
         help="Output format (default: from the output file's extension; X3P on standard output).",
     )(wrapper)
@@ -522,8 +575,6 @@ class Output:
 
     @property
     def is_directory(self):
-        import os
-
         return self.path != "-" and (self.path.endswith(os.sep) or os.path.isdir(self.path))
 
     def check_directory(self, names):
@@ -539,19 +590,13 @@ class Output:
     def for_input(self, name):
         """The output of input ``name``: in the directory, the input's stem with the
         output format's extension; otherwise this output itself."""
-        import os
-
-        from ..errors import InputError
-        from ..io.registry import formats
-        from .batch import stem_name
-
         if not self.is_directory:
             return self
         if name == "-":
-            raise InputError("standard input has no name to write under: give -o FILE", filename=self.path)
+            raise errors.InputError("standard input has no name to write under: give -o FILE", filename=self.path)
         os.makedirs(self.path, exist_ok=True)
         format_name = self.requested_format or "x3p"
-        extension = formats()[format_name].extensions[0]
+        extension = registry.formats()[format_name].extensions[0]
         return Output(os.path.join(self.path, stem_name("{stem}", name) + extension), format_name)
 
     def check(self):
@@ -561,33 +606,28 @@ class Output:
 
     @property
     def format(self):
-        from ..errors import InputError
-        from ..io import format_for_path
-
         if self.requested_format:
             return self.requested_format
         try:
-            return "x3p" if self.path == "-" else format_for_path(self.path)
-        except InputError as error:
+            return "x3p" if self.path == "-" else io.format_for_path(self.path)
+        except errors.InputError as error:
             error.filename = self.path  # names the output: no input name in front
             raise
 
     def write(self, surface):
-        from ..errors import InputError
-        from ..io import BINARY, write
-        from ..io.atomic import atomic_output, names_a_terminal, standard_output
-
-        on_terminal = standard_output() and sys.stdout.isatty() if self.path == "-" else names_a_terminal(self.path)
-        if self.format in BINARY and on_terminal:
-            raise InputError(
+        on_terminal = (
+            io.standard_output() and sys.stdout.isatty() if self.path == "-" else io.names_a_terminal(self.path)
+        )
+        if self.format in io.BINARY and on_terminal:
+            raise errors.InputError(
                 f"refusing to write binary {self.format.upper()} to a terminal: use -o FILE, a pipe, or -f tsv",
                 filename=self.path,
             )
         if self.path != "-":
-            write(surface, self.path, format=self.format)
+            io.write(surface, self.path, format=self.format)
             return
-        with atomic_output("-") as stream:
-            write(surface, stream, format=self.format)
+        with io.atomic_output("-") as stream:
+            io.write(surface, stream, format=self.format)
 
 
 def report_format(command):

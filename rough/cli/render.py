@@ -5,6 +5,8 @@ import math
 
 import click
 
+from .. import fractal, metrology, plots
+from .. import render as haptic
 from .haptics import DAMPING, FORCE, MASS, SPEED, STIFFNESS, TIME, haptic_options
 from .options import CROP, POSITION, TIP, FloatRange, input_options, plot_option, report_format
 from .report import Report, on_stdout, shown
@@ -20,7 +22,7 @@ from .report import Report, on_stdout, shown
     multiple=True,
     metavar="SPEED",
     help="sim: stroke speed (default 20mm/s, slow enough to feel each feature; experiment run strokes at "
-    "60mm/s; repeat for several runs, e.g. --speed 20mm/s --speed 120mm/s). A bare number is in mm/s.",
+    "60mm/s; repeat for several runs, e.g. --speed 20mm/s --speed 120mm/s).",
 )
 @click.option(
     "--duration", type=TIME, help="Run length (default: sim one pass over the window; joysticks until Ctrl-C)."
@@ -112,7 +114,7 @@ def render(
 
     \b
     Examples:
-        rough synth --length 80mm --dimension 1.275 --rq 0.2781mm | rough resample --spacing 0.1545mm \\
+        rough synth --length 80mm --dimension 1.275 --rq 0.2781mm | rough resample --step 0.1545mm \\
             | rough render --speed 20mm/s --speed 60mm/s --speed 120mm/s --trace forces-{speed}.tsv --plot forces.png
         rough render --model dynamic --friction karnopp:static=0.8N,coulomb=0.5N rock.x3p
         rough render --device hid --stick-span 80mm,10mm rough.x3p smooth.x3p
@@ -120,9 +122,6 @@ def render(
         rough render --duration 60s --direction 90 --trace across.tsv lay.x3p
         rough render --tip fingertip --speed 60mm/s fossil.x3p
     """
-    from ..render import MapTrack
-    from ..render.session import run_sim, run_stick, summary_rows
-
     report = not on_stdout(trace=trace, plot=plot)
     if trace == "-" and len(speeds) > 1:
         raise click.BadParameter("with several speeds, the traces need file names with {speed}", param_hint="--trace")
@@ -132,7 +131,7 @@ def render(
     if len({type(track) for track in tracks}) > 1:
         raise click.BadParameter("the two surfaces must both be profiles or both maps (or give --row)")
     settings = haptics.settings(duration, realtime)
-    on_map = isinstance(tracks[0], MapTrack)
+    on_map = isinstance(tracks[0], haptic.MapTrack)
     contact = haptics.field(press) if on_map else haptics.contact()
     friction = haptics.friction_model()
     if haptics.simulated:
@@ -143,10 +142,10 @@ def render(
             hand["direction"] = math.radians(direction)
         else:
             hand["press"] = press
-        runs = run_sim(tracks[0], speeds or (0.02,), contact, friction, settings, **hand)
+        runs = haptic.run_sim(tracks[0], speeds or (0.02,), contact, friction, settings, **hand)
     else:
         runs = [
-            run_stick(
+            haptic.run_stick(
                 haptics.device,
                 tracks,
                 functools.partial(haptics.device_model, contact, press),
@@ -157,35 +156,25 @@ def render(
             )
         ]
     _outputs(runs, trace, plot, shown(inputs[0]))
-    return Report(*summary_rows(runs, haptics.friction)) if report else None
+    return Report(*haptic.summary_rows(runs, haptics.friction)) if report else None
 
 
 def _track(surface, window, fill, tip, row):
     """The Track (a profile, or a map's row) or MapTrack that ``surface`` is rendered as."""
-    from ..render import MapTrack, Track
-
     if window is not None:
         surface = surface.crop(window[0], window[1] if not surface.is_profile else None)
     if fill:
-        from ..fractal.resample import fill_invalid
-
-        surface = fill_invalid(surface)
+        surface = fractal.fill_invalid(surface)
     if tip is not None:
-        from ..metrology.tip import traced
-
-        surface = traced(surface, tip)
+        surface = metrology.traced(surface, tip)
     if surface.is_profile or row is not None:
-        return Track.from_surface(surface, row=row)
-    return MapTrack.from_surface(surface)
+        return haptic.Track.from_surface(surface, row=row)
+    return haptic.MapTrack.from_surface(surface)
 
 
 def _outputs(runs, trace, plot, title):
-    from ..render import write_trace
-
     if trace:
         for label, result in runs:
-            write_trace(result, trace.replace("{speed}", label))
+            haptic.write_trace(result, trace.replace("{speed}", label))
     if plot:
-        from .. import plots
-
         plots.save(plots.force_figure(runs, title=title), plot)

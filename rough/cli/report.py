@@ -25,6 +25,8 @@ import math
 
 import click
 
+from .. import io
+
 
 @dataclasses.dataclass
 class Report:
@@ -47,9 +49,7 @@ def shown(file):
 
 def echo(line):
     """Print one line on standard output; a RoughError when it is closed."""
-    from ..io.atomic import standard_output
-
-    standard_output()
+    io.standard_output()
     click.echo(line)
 
 

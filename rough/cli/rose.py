@@ -1,15 +1,21 @@
 """rough rose: direction-dependent fractal dimension and amplitude coefficient."""
 
+import math
+
 import click
 
+from .. import fractal, plots
+from ..units import format_length, format_quantity
 from .options import (
     BAND,
     LENGTH,
     FloatRange,
+    RegistryChoice,
     crop_option,
     gaps_option,
     model_options,
     plot_option,
+    renamed,
     report_format,
     surface_input,
 )
@@ -20,18 +26,19 @@ from .report import Report, on_stdout, shown
 @surface_input
 @crop_option
 @click.option(
-    "--step",
+    "--angle-step",
     type=FloatRange(1, 90),
     default=10.0,
     show_default=True,
     help="Angle between sector centres (degrees; must divide 180).",
 )
+@renamed("--step", "--angle-step", "angle_step", FloatRange(1, 90))
 @click.option(
     "--width",
     type=FloatRange(1, 180),
-    help="Sector width in degrees (default: the step, sectors not overlapping).",
+    help="Sector width in degrees (default: the angle step, sectors not overlapping).",
 )
-@click.option("--band", type=BAND, help="Fit band FMIN:FMAX in cycles per length (bare numbers per mm).")
+@click.option("--band", type=BAND, help="Fit band FMIN:FMAX in cycles per length, e.g. 0.1/mm:20/mm.")
 @click.option("--resolution", type=LENGTH, help="The resolution η at which C is stated (default: the smaller spacing).")
 @click.option(
     "--order",
@@ -40,7 +47,7 @@ from .report import Report, on_stdout, shown
     show_default=True,
     help="Polynomial form removed first (a plane: the spectrum needs only the tilt gone; detrend's default is 2).",
 )
-@click.option("--sampling", type=click.Choice(["point", "band-limited"]), help="As for fit-fractal.")
+@click.option("--sampling", type=RegistryChoice(lambda: fractal.SAMPLINGS), help="As for fit-fractal.")
 @click.option("--fill", is_flag=True, help="Fill invalid points first (biharmonic inpainting).")
 @click.option(
     "--profiles",
@@ -55,7 +62,7 @@ from .report import Report, on_stdout, shown
 def rose(
     surface,
     input,
-    step,
+    angle_step,
     width,
     band,
     resolution,
@@ -87,40 +94,28 @@ def rose(
     \b
     Examples:
         rough rose scan.x3p
-        rough rose --step 15 --plot rose.png --json fault.x3p
-        rough rose --step 15 --profiles fault.npz
-        rough synth --size 1024x1024 --spacing 10um --anisotropy 2.2,1um,2.5,3um,30 | rough rose
+        rough rose --angle-step 15 --plot rose.png --json fault.x3p
+        rough rose --angle-step 15 --profiles fault.npz
+        rough synth --size 1024x1024 --step 10um --anisotropy 2.2,1um,2.5,3um,30 | rough rose
     """
-
-    from ..fractal.resample import fill_invalid
-    from ..fractal.rose import rose as directions
-
     if fill:
-        surface = fill_invalid(surface)
+        surface = fractal.fill_invalid(surface)
     model = {"band": band, "resolution": resolution, "order": order, "sampling": sampling, "noise": noise}
     model.update(rolloff=rolloff, level=level, tip_radius=tip_radius)
-    result = directions(surface, step=step, width=width, **model)
+    result = fractal.rose(surface, angle_step, width=width, **model)
     if plot:
-        from .. import plots
-
         plots.save(plots.rose_figure(result, shown(input)), plot)
     if on_stdout(plot=plot):
         return None
     document, rows = result.as_dict(), _rows(result)
     if profiles:
-        import math
-
-        from ..fractal.profiles import profile_rose
-
-        along = profile_rose(surface, step=math.radians(step), gaps=gaps, **model)
+        along = fractal.profile_rose(surface, math.radians(angle_step), gaps=gaps, **model)
         document["profiles"] = along.as_dict()
         rows += _profile_rows(along)
     return Report(rows, document)
 
 
 def _sector_text(dimension, dimension_error, amplitude, amplitude_error):
-    from ..units import format_length
-
     if dimension_error is None:
         return f"Ds = {dimension:.4f} (bound)   C = {format_length(amplitude)}"
     spread = f"{format_length(amplitude)} ± {format_length(amplitude_error)}"
@@ -150,8 +145,6 @@ def _fit_text(fit):
 
 
 def _rows(result):
-    from ..units import format_length, format_quantity
-
     document = result.as_dict()
     rows = [
         (
@@ -220,7 +213,12 @@ def _rows(result):
             f"C flat {isotropy['amplitude_coefficient']:.3g}",
         ),
         ("Str", result.Str, "1", f"{format_quantity(result.Str, '1')} (texture aspect ratio, ISO 25178-2)"),
-        ("Std", result.Std, "deg", f"{format_quantity(result.Std, 'deg')} (lay direction from the angular spectrum)"),
+        (
+            "Std",
+            result.Std,
+            "deg",
+            f"{format_quantity(result.Std, 'deg')} (lay direction from the angular spectrum)",
+        ),
         (
             "band",
             list(result.band),
@@ -251,8 +249,6 @@ PROFILE_UNITS = {
 
 def _profile_rows(along):
     """The profiles' H(θ), D(θ), C(θ): one row per direction, after a header naming them."""
-    from ..units import format_length
-
     rows = [
         (
             None,

@@ -4,7 +4,9 @@ import os
 
 import click
 
-from .options import crop_option, surface_input
+from .. import extras, metrology, plots
+from .options import crop_option, renamed, surface_input
+from .report import shown
 
 FORMATS = ("png", "svg", "pdf")
 
@@ -12,11 +14,9 @@ FORMATS = ("png", "svg", "pdf")
 def _needs_matplotlib(ctx, param, value):
     """Check, before any work, that matplotlib is installed and that the output's
     format is known (from ``--format`` or the file's extension)."""
-    from ..extras import require
-
-    require("matplotlib")
-    if "figure_file" in ctx.params and "figure_format" in ctx.params:
-        _format(ctx.params["figure_file"], ctx.params["figure_format"])
+    extras.require("matplotlib")
+    if "plot" in ctx.params and "figure_format" in ctx.params:
+        _format(ctx.params["plot"], ctx.params["figure_format"])
     return value
 
 
@@ -30,18 +30,17 @@ def _format(output, format):
     if extension not in FORMATS:
         raise click.BadParameter(
             f"{output!r}: cannot tell the format from .{extension}; name a .png, .svg or .pdf file or give --format",
-            param_hint="'-o' / '--output'",
+            param_hint="'--plot'",
         )
     return extension
 
 
 @click.command(short_help="Draw a profile or map: height colour map (or hill shade) with units, scale bar and NaN.")
+@renamed(("-o", "--output"), "--plot", "plot")  # outside surface_input: it names one figure per input
 @surface_input
 @crop_option
 @click.option(
-    "-o",
-    "--output",
-    "figure_file",  # a side file (rough.cli.batch.SIDE_FILES): {stem} in its name names one per input
+    "--plot",  # a side file (rough.cli.batch.SIDE_FILES): {stem} in its name names one per input
     default="-",
     metavar="FILE",
     show_default=True,
@@ -77,7 +76,7 @@ def _format(output, format):
     help="Colour map of the heights (cividis reads the same to colour-blind eyes).",
 )
 @click.option("--dpi", type=click.IntRange(30, 1200), default=150, show_default=True, help="Resolution of PNG output.")
-def show(surface, input, figure_file, figure_format, title, hillshade, order, colormap, dpi):
+def show(surface, input, plot, figure_format, title, hillshade, order, colormap, dpi):
     """Draw the profile or map in INPUT (default: standard input), for a quick look.
 
     A map is drawn as a height colour map at equal physical aspect (a 10 mm × 0.5 mm
@@ -93,25 +92,20 @@ def show(surface, input, figure_file, figure_format, title, hillshade, order, co
 
     \b
     Examples:
-        rough show scan.x3p -o scan.png
-        rough show --hillshade --order 1 -o scan.pdf scan.x3p
-        rough synth --size 512x64 --spacing 10um --dimension 2.3 --rq 1um | rough show -o strip.svg
+        rough show scan.x3p --plot scan.png
+        rough show --hillshade --order 1 --plot scan.pdf scan.x3p
+        rough synth --size 512x64 --step 10um --dimension 2.3 --rq 1um | rough show --plot strip.svg
         rough show scan.x3p | display
-        rough show a.x3p b.x3p -o {stem}.png
+        rough show a.x3p b.x3p --plot {stem}.png
     """
-    from .. import plots
-    from .report import shown
-
-    format = _format(figure_file, figure_format)
+    format = _format(plot, figure_format)
     note = None
     if order is not None:
-        from ..metrology import detrend
-
-        surface = detrend(surface, order=order)
+        surface = metrology.detrend(surface, order=order)
         note = {0: "mean removed", 1: "least-squares plane removed"}.get(
             order, f"least-squares polynomial of degree {order} removed"
         )
     figure = plots.surface_figure(
         surface, title=title or shown(input), hillshade=hillshade, note=note, colormap=colormap
     )
-    plots.save(figure, figure_file, format=format, dpi=dpi)
+    plots.save(figure, plot, format=format, dpi=dpi)

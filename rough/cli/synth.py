@@ -1,8 +1,11 @@
 """rough synth: fractal profiles and maps with chosen D and C or Rq."""
 
+import math
+
 import click
 
-from .options import LENGTH, FloatRange, surface_output
+from .. import errors, fractal, units
+from .options import LENGTH, FloatRange, renamed, surface_output
 
 
 class SizeType(click.ParamType):
@@ -27,8 +30,6 @@ class AnisotropyType(click.ParamType):
     def convert(self, value, param, ctx):
         if isinstance(value, tuple):
             return value
-        import math
-
         parts = str(value).split(",")
         if len(parts) != 5:
             self.fail(f"{value!r}: give Ds1,C1,Ds2,C2,ANGLE, e.g. 2.2,1um,2.4,3um,30", param, ctx)
@@ -46,12 +47,13 @@ ANGLE = FloatRange(-360, 360)
 @click.option("--points", type=click.IntRange(2, None), help="Profile length in points.")
 @click.option("--size", type=SizeType(), help="Map size in points, NXxNY (a map).")
 @click.option(
-    "--spacing",
+    "--step",
     type=LENGTH,
     default="0.0309mm",
     show_default=True,
-    help="Sampling interval (the default is the paper's encoder resolution).",
+    help="Sampling interval of the surface made (the default is the paper's encoder resolution).",
 )
+@renamed("--spacing", "--step", "step", LENGTH)
 @click.option(
     "--dimension",
     type=FloatRange(1, 3, min_open=True, max_open=True),
@@ -62,7 +64,7 @@ ANGLE = FloatRange(-360, 360)
     type=LENGTH,
     help="Amplitude coefficient C at --resolution: G(f) = C η^(2D-3) f^-(5-2D) (maps: C of their profiles).",
 )
-@click.option("--resolution", type=LENGTH, help="The resolution η that C refers to (default: the spacing).")
+@click.option("--resolution", type=LENGTH, help="The resolution η that C refers to (default: the step).")
 @click.option(
     "--rq",
     type=LENGTH,
@@ -80,10 +82,11 @@ ANGLE = FloatRange(-360, 360)
     "2.2,1um,2.4,3um,30.",
 )
 @click.option(
-    "--rolloff",
+    "--rolloff-wavelength",
     type=LENGTH,
     help="Wavelength beyond which the spectrum is flat: self-affine only below it (rock is, over finite scales).",
 )
+@renamed("--rolloff", "--rolloff-wavelength", "rolloff_wavelength", LENGTH)
 @click.option(
     "--fragments",
     type=click.IntRange(4, None),
@@ -98,14 +101,14 @@ def synth(
     length,
     points,
     size,
-    spacing,
+    step,
     dimension,
     amplitude,
     resolution,
     rq,
     seed,
     anisotropy,
-    rolloff,
+    rolloff_wavelength,
     fragments,
     as_printed,
     output,
@@ -114,44 +117,42 @@ def synth(
     power spectrum is G(f) = C η^(2D-3) f^-(5-2D), in one inverse transform over
     the whole length: independent Gaussian coefficients, no DC term, so the
     realised Rq has the spectrum's expectation (with --rq it is exact). Lengths
-    take a unit; a bare number is in mm.
+    name their unit.
 
     \b
     Examples:
         rough synth --length 80mm --dimension 1.275 --rq 0.2781mm --seed 1 -o rock.x3p
-        rough synth --size 1024x1024 --spacing 10um --dimension 2.3 --amplitude 1um | rough fit-fractal
-        rough synth --size 512x512 --spacing 10um --dimension 2.3 --anisotropy 2.2,1um,2.5,1um,30 -o layered.x3p
+        rough synth --size 1024x1024 --step 10um --dimension 2.3 --amplitude 1um | rough fit-fractal
+        rough synth --size 512x512 --step 10um --dimension 2.3 --anisotropy 2.2,1um,2.5,1um,30 -o layered.x3p
         rough synth --length 80mm --dimension 1.275 --rq 0.2781mm --fragments
     """
-    from ..errors import InputError
-    from ..fractal import synth as make
-
     if size is None and length is None and points is None:
-        raise InputError("give --length or --points for a profile, or --size for a map")
+        raise errors.InputError("give --length or --points for a profile, or --size for a map")
     if dimension is None and anisotropy is None:
-        raise InputError("give the fractal dimension (--dimension)")
+        raise errors.InputError("give the fractal dimension (--dimension)")
     if size is not None:
         if fragments or length is not None or points is not None:
-            raise InputError("a map takes --size only (no --length, --points or --fragments)")
-        surface = make.synthesize_map(
-            size, (spacing, spacing), dimension, amplitude, rq, resolution, seed, anisotropy, rolloff
+            raise errors.InputError("a map takes --size only (no --length, --points or --fragments)")
+        surface = fractal.synthesize_map(
+            size, (step, step), dimension, amplitude, rq, resolution, seed, anisotropy, rolloff_wavelength
         )
     else:
         if anisotropy is not None:
-            raise InputError("--anisotropy needs a map (--size)")
-        count = points if points is not None else round(length / spacing)
+            raise errors.InputError("--anisotropy needs a map (--size)")
+        count = points if points is not None else round(length / step)
         if count < 2:
-            from ..units import format_length
-
-            raise InputError(
-                f"--length {format_length(length)} holds fewer than two samples at the spacing {format_length(spacing)}"
+            raise errors.InputError(
+                f"--length {units.format_length(length)} holds fewer than two samples at the step "
+                f"{units.format_length(step)}"
             )
         if fragments:
-            if rolloff is not None:
-                raise InputError("--rolloff does not apply to the paper's fragments")
-            surface = make.synthesize_fragments(
-                count, spacing, dimension, amplitude, rq, resolution, seed, fragments, as_printed
+            if rolloff_wavelength is not None:
+                raise errors.InputError("--rolloff-wavelength does not apply to the paper's fragments")
+            surface = fractal.synthesize_fragments(
+                count, step, dimension, amplitude, rq, resolution, seed, fragments, as_printed
             )
         else:
-            surface = make.synthesize_profile(count, spacing, dimension, amplitude, rq, resolution, seed, rolloff)
+            surface = fractal.synthesize_profile(
+                count, step, dimension, amplitude, rq, resolution, seed, rolloff_wavelength
+            )
     output.write(surface)

@@ -34,3 +34,7 @@ Progress(answered=8, remaining=0, total=8, interrupted=False)
 (24, ['fractal_dimension', 'rq', 'subject_S02', 'subject_S03', 'constant'])
 >>> folder.cleanup()
 """
+
+import lazy_loader
+
+__getattr__, __dir__, __all__ = lazy_loader.attach_stub(__name__, __file__)

@@ -12,10 +12,13 @@ constant), and sets with different references can be pooled.
 import dataclasses
 import math
 import warnings
+from statistics import NormalDist
 
 import numpy as np
+from scipy.stats import chi2, norm
 
 from ..errors import InputError
+from ..extras import require
 from .session import read_answers
 
 SEPARATED_LOGIT = 15.0  # |linear predictor| beyond which a fitted probability is 1 - 3e-7: certainty
@@ -23,8 +26,6 @@ SEPARATED_LOGIT = 15.0  # |linear predictor| beyond which a fitted probability i
 
 def wald_p(statistic):
     """Two-sided p-value of a Wald statistic: 2(1 − Φ(|W|))."""
-    from scipy.stats import norm
-
     return float(2.0 * norm.sf(abs(statistic)))
 
 
@@ -249,8 +250,6 @@ def fit(table, subject_order=None):
     for name in ("fractal_dimension", "rq"):
         reduced = _logit(table["rougher"], {k: v for k, v in columns.items() if k != name})
         statistic = max(0.0, 2.0 * (full.llf - reduced.llf))
-        from scipy.stats import chi2
-
         ratio[name] = {"statistic": statistic, "p": float(chi2.sf(statistic, 1))}
     design = np.column_stack(list(columns.values()))
     separation = (not full.mle_retvals.get("converged", True)) or bool(
@@ -269,8 +268,6 @@ def fit(table, subject_order=None):
 
 
 def _logit(response, columns):
-    from ..extras import require
-
     sm = require("statsmodels.api")
 
     design = np.column_stack(list(columns.values()))
@@ -306,3 +303,42 @@ def percentages(study, set_id):
             (name, test["dimension"], test["rq"], 100.0 * np.mean(chosen) if chosen else math.nan, len(chosen))
         )
     return result
+
+
+def proportion_interval(successes, trials, level=0.95):
+    """The Wilson score interval for a proportion: ``successes`` of ``trials``.
+
+    Uses :func:`statsmodels.stats.proportion.proportion_confint` (``method="wilson"``)
+    when statsmodels is installed, else the same closed form.
+
+    Parameters
+    ----------
+    successes, trials : int
+        Counts, ``0 <= successes <= trials``, ``trials > 0``.
+    level : float, default 0.95
+        The confidence level.
+
+    Returns
+    -------
+    tuple of float
+        ``(low, high)``, proportions in [0, 1].
+
+    Examples
+    --------
+    >>> from rough.experiment import proportion_interval
+    >>> [round(p, 4) for p in proportion_interval(6, 8)]
+    [0.4093, 0.9285]
+    >>> [round(p, 4) for p in proportion_interval(0, 8)]
+    [0.0, 0.3244]
+    """
+    try:
+        from statsmodels.stats.proportion import proportion_confint  # optional: experiment
+    except ImportError:
+        z = NormalDist().inv_cdf(0.5 + level / 2)
+        p = successes / trials
+        denominator = 1 + z**2 / trials
+        centre = (p + z**2 / (2 * trials)) / denominator
+        half = z / denominator * math.sqrt(p * (1 - p) / trials + z**2 / (4 * trials**2))
+        return max(0.0, centre - half), min(1.0, centre + half)
+    low, high = proportion_confint(successes, trials, alpha=1 - level, method="wilson")
+    return float(low), float(high)

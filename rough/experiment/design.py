@@ -31,6 +31,7 @@ import tempfile
 import numpy as np
 
 from ..errors import InputError
+from ..fractal import resample, synthesize_profile
 
 FORMAT = "rough-study 1"
 TRIAL_FIELDS = ("subject", "trial", "set", "reference", "test", "first", "second")
@@ -278,9 +279,6 @@ def write_study(folder, surfaces, sets, subjects, seed, length, synthesis_spacin
     True
     >>> folder.cleanup()
     """
-    from ..fractal.resample import resample
-    from ..fractal.synth import synthesize_profile
-
     folder = pathlib.Path(folder)
     if folder.exists() and (not folder.is_dir() or any(folder.iterdir())):
         raise InputError(f"{folder}: exists and is not an empty folder; choose a new study folder")

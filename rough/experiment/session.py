@@ -12,6 +12,7 @@ keys 1 and 2 on the keyboard do the same. With the simulated hand, a scripted
 :class:`~.observer.Observer` answers after the hand has stroked both surfaces.
 """
 
+import contextlib
 import csv
 import dataclasses
 import datetime
@@ -22,6 +23,13 @@ import threading
 import time
 
 from ..errors import InputError
+from ..io import read
+from ..io.atomic import atomic_output
+from ..progress import progress
+from ..render.device import HeldOpen
+from ..render.loop import run
+from ..render.simulation import simulate
+from ..render.track import Track
 from .design import TRIAL_FIELDS, read_rows
 
 ANSWER_FIELDS = TRIAL_FIELDS + (
@@ -194,10 +202,6 @@ def run_session(study, subject, present, device_name):
 def _trials_bar(subject, count, device_name):
     """A progress bar over the simulated hand's trials (none on a joystick, whose
     subject needs the terminal quiet)."""
-    import contextlib
-
-    from ..progress import progress
-
     if device_name != "sim":
         return contextlib.nullcontext(_NoBar())
     return progress(total=count, description=f"{subject}: trials", unit="trial")
@@ -233,8 +237,6 @@ def _answers_file(study, subject):
 
 
 def _save(study, subject, rows):
-    from ..io.atomic import atomic_output
-
     path = _answers_file(study, subject)
     path.parent.mkdir(exist_ok=True)
     text = io.StringIO()
@@ -300,9 +302,6 @@ def simulated_presenter(study, observer, speed, model, friction, settings, **han
     Progress(answered=8, remaining=0, total=8, interrupted=False)
     >>> folder.cleanup()
     """
-    from .. import read
-    from ..render import Track, simulate
-
     tracks = {}
 
     def present(trial):
@@ -335,8 +334,8 @@ class Keyboard:
         if sys.stdin is None:
             return
         if sys.stdin.isatty():
-            import termios
-            import tty
+            import termios  # optional: POSIX terminals only
+            import tty  # optional: POSIX terminals only
 
             descriptor = sys.stdin.fileno()
             saved = termios.tcgetattr(descriptor)
@@ -365,9 +364,6 @@ def joystick_presenter(tracks, joystick, model, friction, settings, keyboard):
     """Present a trial on the joystick until the subject answers; ``tracks`` maps every
     surface name of the study to its :class:`~rough.render.Track`, read before the first
     trial so that trials follow each other without a pause."""
-    from ..render.device import HeldOpen
-    from ..render.loop import run
-
     held = HeldOpen(joystick)
 
     def answered(buttons):

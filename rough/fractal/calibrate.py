@@ -28,6 +28,7 @@ import scipy.fft
 
 from ..errors import InputError
 from . import estimators as est
+from .jackknife import jackknife_variance, neighbour_blocks
 
 GRID = np.linspace(0.02, 0.98, 17)  # the H of the calibration curve
 QUANTILE = 1.959963984540054  # the central 95 % of a normal distribution: mean ± this many SD
@@ -57,7 +58,7 @@ class Calibrated:
     Attributes
     ----------
     estimator : str
-        The name in :data:`rough.fractal.estimators.ESTIMATORS`.
+        The name in :data:`rough.fractal.ESTIMATORS`.
     raw : float
         The estimator's raw H.
     hurst : float
@@ -282,10 +283,8 @@ def invert(curve, raw, floor=0.0):
 def block_spread(name, profiles, spacing, scales, positions, noisy=True):
     """The delete-one-block jackknife SD of the raw Ĥ (the Whittle fit with a noise
     floor only for ``noisy`` data), or None with too few profiles for the blocks of
-    :func:`rough.fractal.profiles.neighbour_blocks` (the blocks of neighbours whose
+    :func:`rough.fractal.jackknife.neighbour_blocks` (the blocks of neighbours whose
     jackknife gives the pooled fit's standard errors)."""
-    from .profiles import jackknife_variance, neighbour_blocks
-
     positions = np.asarray(positions, dtype=float)
     if positions.shape != (len(profiles),) or not np.isfinite(positions).all():
         raise InputError("positions must give one finite offset per profile")
@@ -316,7 +315,7 @@ def calibrated(
     Parameters
     ----------
     name : str
-        An estimator of :data:`rough.fractal.estimators.ESTIMATORS`.
+        An estimator of :data:`rough.fractal.ESTIMATORS`.
     heights : list of 1-D arrays
         Finite heights (m) with their form removed; NaN is refused (give finite runs).
     spacing : float

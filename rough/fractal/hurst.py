@@ -2,12 +2,12 @@
 (docs/math.rst §1.9-1.10).
 
 The profiles along a direction are fitted first by the pooled Whittle likelihood
-(:func:`rough.fractal.profiles.fit_profiles`), which finds the scaling range, the noise
+(:func:`rough.fractal.fit_profiles`), which finds the scaling range, the noise
 floor and C. The Whittle estimator measures H over that band, the others over their
 default ranges of lags, windows or steps (over the band when the user sets it), and
 each is calibrated on exact fBm of the profiles' own count, lengths, spacing and noise
 (band-limited fractal profiles when the surface's history says rough made its
-spectrum; :func:`rough.fractal.calibrate.compare`).
+spectrum; :func:`rough.fractal.compare`).
 """
 
 import dataclasses
@@ -111,23 +111,23 @@ def hurst_exponents(
     ----------
     surface : Surface
         A map (its profiles along ``direction``) or a profile; invalid (NaN) points are
-        handled by the gap rule of :func:`rough.fractal.profiles.take_profiles`.
+        handled by the gap rule of :func:`rough.fractal.take_profiles`.
     direction : {"x", "y"} or float
-        As for :func:`~rough.fractal.profiles.take_profiles` (ignored for a profile).
+        As for :func:`~rough.fractal.take_profiles` (ignored for a profile).
     estimators : list of str, optional
-        Names in :data:`rough.fractal.estimators.ESTIMATORS`; None: all of them, the
+        Names in :data:`rough.fractal.ESTIMATORS`; None: all of them, the
         Whittle fit first.
     gaps, order
-        As for :func:`~rough.fractal.profiles.take_profiles`.
+        As for :func:`~rough.fractal.take_profiles`.
     band, resolution, sampling, noise, rolloff, level, tip_radius
-        As for :func:`~rough.fractal.profiles.fit_profiles`. The Whittle estimator
+        As for :func:`~rough.fractal.fit_profiles`. The Whittle estimator
         measures over the band that fit finds; the others over their default scale
         ranges (docs/math.rst §1.10), which were calibrated and compared with the
         literature's benchmarks, unless ``band`` or ``tip_radius`` sets the band:
         then every estimator measures over it (as lags, windows, scales or steps).
     replicates : int, optional
         Synthetic replicates per calibration point (None: as many as the data's size
-        allows; see :func:`rough.fractal.calibrate.compare`).
+        allows; see :func:`rough.fractal.compare`).
     seed : int, default 0
         Seed of the synthetic data: the result is deterministic from it.
 
@@ -138,8 +138,8 @@ def hurst_exponents(
     Raises
     ------
     rough.InputError
-        For an unknown estimator, and as :func:`~rough.fractal.profiles.fit_profiles`
-        and :func:`~rough.fractal.calibrate.compare`.
+        For an unknown estimator, and as :func:`~rough.fractal.fit_profiles`
+        and :func:`~rough.fractal.compare`.
 
     Examples
     --------

@@ -88,11 +88,3 @@ def eq2_rq(amplitude_value, dimension, resolution, length, sampling=None):
     tau = resolution if sampling is None else sampling
     exponent = 4.0 - 2.0 * dimension
     return math.sqrt(prefactor(amplitude_value, dimension, resolution) * (length**exponent - tau**exponent) / exponent)
-
-
-def aliased_sum(exponent, u):
-    """Σ_m |u + m|^-exponent over all integers m, for u in (0, 1): the fold of a power
-    law onto the base band (Hurwitz zeta: ζ(β, u) + ζ(β, 1 - u)). Needs exponent > 1."""
-    from scipy.special import zeta
-
-    return zeta(exponent, u) + zeta(exponent, 1.0 - u)

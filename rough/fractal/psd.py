@@ -16,8 +16,11 @@ Other conventions of the same spectrum (all functions of frequency f in 1/m):
 import math
 
 import numpy as np
+from scipy import fft
 
 from ..errors import InputError
+from ..metrology import detrend
+from ..metrology.form import form_factors
 
 WINDOWS = ("hann", "none")
 
@@ -74,8 +77,6 @@ def windowed_map(surface, order=1, rows_per_block=256):
     """``(field, power)``: the map less its polynomial form of ``order``, times the 2-D
     periodic Hann window, in float32 (computed a block of rows at a time, so no
     full-size temporaries); ``power`` is the window's mean square."""
-    from ..metrology.form import form_factors
-
     along_y, coefficients, along_x = form_factors(surface, order)
     ny, nx = surface.heights.shape
     window_y, window_x = periodic_hann(ny), periodic_hann(nx)
@@ -106,8 +107,6 @@ def sector_spectra(field, power, spacing, low, high, step, sectors=None, rows_pe
     width/2 of its centre (sectors overlap when the width exceeds the step). Returns
     one ring dictionary per sector (one in all without sectors). Works a block of rows
     at a time; pass ``transform`` (the field's rfft2) to reuse one."""
-    from scipy import fft
-
     ny, nx = field.shape
     dx, dy = spacing
     transform = fft.rfft2(field, workers=-1) if transform is None else transform
@@ -208,8 +207,6 @@ def binned_spectrum(surface, order=1, per_decade=10):
     ring-averaged periodic-Hann P2 (m⁴). Returns ``{"frequency", "density", "count"}``
     (lists; 1/m) and, for profiles, ``"parseval"`` (Σ G Δf over the windowed power)."""
     if surface.is_profile:
-        from ..metrology import detrend
-
         levelled = detrend(surface, order=order)
         frequencies, density, parseval = periodogram(levelled.heights, surface.spacing[0])
         centres, means, counts = log_bins(frequencies, density, per_decade)
@@ -243,7 +240,7 @@ def profile_spectrum(heights, spacing, per_decade=10):
     ----------
     heights : list of 1-D arrays
         Profiles with their form removed (e.g. :attr:`ProfileSet.heights
-        <rough.fractal.profiles.ProfileSet>`), m; NaN is not allowed.
+        <rough.fractal.profile_set.ProfileSet>`), m; NaN is not allowed.
     spacing : float
         The sampling step along the profiles, m.
     per_decade : int, default 10

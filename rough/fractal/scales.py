@@ -82,7 +82,7 @@ def scale_dependent_roughness(surface, direction="x"):
     ----------
     surface : Surface
         A gap-free profile or map: fill invalid (NaN) points first (see
-        :func:`rough.fractal.resample.fill_invalid`).
+        :func:`rough.fractal.fill_invalid`).
     direction : {"x", "y"}, default "x"
         For a map, the profiles along x (rows) or y (columns); ignored for a profile.
 

@@ -36,6 +36,8 @@ import dataclasses
 import math
 
 import numpy as np
+from scipy.optimize import minimize, minimize_scalar
+from scipy.special import chdtrc, gammainc, gammaincc, ndtri, zeta  # scipy.stats' own, without its import time
 
 GOF_PER_DECADE = 10
 NOISE_LOG_RATIO = (-15.0, 15.0)
@@ -126,8 +128,6 @@ def log_power(bins, exponent):
 def profile_bins(frequencies, spacing, ordinates, sampling):
     """One bin per ordinate of the periodogram of a profile's first differences
     (two-sided, ``Δ/m |DFT|²``) at ``frequencies`` (1/m)."""
-    from . import model
-
     u = frequencies * spacing
     shape = math.log(2.0) + np.log(np.sin(np.pi * u) ** 2)
     log_f = np.log(frequencies)
@@ -146,11 +146,17 @@ def profile_bins(frequencies, spacing, ordinates, sampling):
             return 0.0
         u = np.exp(bins.means["log_f"]) * spacing
         grid = np.geomspace(u.min(), u.max(), 257) if u.size > 257 else u
-        folded = model.aliased_sum(exponent, grid) * grid**exponent - 1.0
+        folded = aliased_sum(exponent, grid) * grid**exponent - 1.0
         return np.log1p(np.interp(u, grid, folded))
 
     ones = np.ones(frequencies.size)
     return Bins(ones.astype(np.int64), ones, ordinates, means, fold)
+
+
+def aliased_sum(exponent, u):
+    """Σ_m |u + m|^-exponent over all integers m, for u in (0, 1): the fold of a power
+    law onto the base band (Hurwitz zeta: ζ(β, u) + ζ(β, 1 - u)). Needs exponent > 1."""
+    return zeta(exponent, u) + zeta(exponent, 1.0 - u)
 
 
 def ring_bins(rings, spacing):
@@ -245,8 +251,6 @@ def power_law_found(fit):
 
 
 def gof_p_value(bins, expected, parameters, per_decade=GOF_PER_DECADE):
-    from scipy.special import chdtrc, gammainc, gammaincc, ndtri  # scipy.stats' own, without its import time
-
     merged = bins.grouped(per_decade)
     weight = merged.weight
     ratio = merged.density * merged.count / np.add.reduceat(bins.count * expected, bins.starts(per_decade))
@@ -277,8 +281,6 @@ def fit_spectrum(bins, exponent_range, noise=True, rolloff=False):
 
 
 def _fit(bins, exponent_range, noise, rolloff):
-    from scipy.optimize import minimize, minimize_scalar
-
     weight, density, total = bins.weight, bins.density, bins.weight.sum()
     noise_shape = bins.means["noise"] / bins.means["noise"][-1]
     f2 = bins.means["f2"] / bins.means["f2"][-1]

@@ -16,7 +16,7 @@ import numpy as np
 
 from ..errors import FormatError
 from ..surface import Surface, Units, check_size
-from .header import header_count, header_number, length_unit
+from .header import check_length, header_count, header_number, length_unit
 from .registry import Format
 
 FORMAT = Format(
@@ -45,12 +45,7 @@ def read(data, options):
     order = "<" if _number(fields, "intelmode", 1) else ">"
     dtype = np.dtype(f"{order}f4" if floats else f"{order}i2")
     end = start + nx * ny * dtype.itemsize
-    if end > len(data):
-        raise FormatError(f"BCR image of {nx}×{ny} points runs past the end of the file ({len(data)} bytes)")
-    if end < len(data):
-        raise FormatError(
-            f"BCR file holds {len(data):,} bytes, its header describes {end:,} (header and {nx}×{ny} points)"
-        )
+    check_length(data, end, "BCR", f"header and {nx}×{ny} points")
     raw = np.ndarray((ny, nx), dtype, data, start).astype(np.float64)
     invalid = raw > FLOAT_VOID if floats else raw == INT_VOID
     xy_unit, z_unit = fields.get("xunit", "nm"), fields.get("zunit", "nm")

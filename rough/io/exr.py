@@ -24,6 +24,7 @@ import sys
 import numpy as np
 
 from ..errors import FormatError
+from ..extras import require
 from ..surface import Surface, Units
 from ..units import metres_per
 from . import limits, provenance
@@ -36,6 +37,9 @@ FORMAT = Format(
     magic=(b"\x76\x2f\x31\x01",),
     writes=True,
     carries=("spacing", "units", "metadata", "history"),
+    height_type="float32",
+    read_library="OpenEXR",
+    write_library="OpenEXR",
 )
 
 HEIGHT_CHANNELS = ("Y", "Z", "R")
@@ -47,7 +51,7 @@ TILED, DEEP, MULTIPART = 0x200, 0x800, 0x1000  # flags of the version field
 
 
 def read(data, options):
-    import OpenEXR
+    OpenEXR = require("OpenEXR")
 
     with _library_quiet():
         parts = _open(OpenEXR, data, header_only=True).parts
@@ -86,7 +90,7 @@ def read(data, options):
 
 
 def write(surface, stream):
-    import OpenEXR
+    OpenEXR = require("OpenEXR")
 
     heights = np.ascontiguousarray(np.atleast_2d(surface.heights), dtype=np.float32)
     ny, nx = heights.shape

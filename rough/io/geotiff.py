@@ -52,8 +52,10 @@ FORMAT = Format(
     (".tif", ".tiff"),
     magic=(b"II*\0", b"MM\0*", b"II+\0", b"MM\0+"),
     writes=True,
+    writes_profiles=False,
     carries=("spacing", "units", "metadata", "channels", "mask", "history", "crs"),
-    library="rasterio",
+    read_library="rasterio",
+    write_library="rasterio",
 )
 
 log = logging.getLogger("rough")

@@ -26,6 +26,7 @@ FORMAT = Format(
     magic=(b"Gwyddion Simple Field",),
     writes=True,
     carries=("spacing", "units", "metadata", "mask", "history"),
+    height_type="float32",
 )
 
 MAGIC = b"Gwyddion Simple Field 1.0"

@@ -36,10 +36,11 @@ import struct
 import numpy as np
 
 from ..errors import FormatError, InputError
+from ..extras import require
 from ..surface import Surface, Units, check_size
 from ..units import metres_per
 from . import provenance, regrid
-from .registry import Format, channel_list, channel_metadata, choose_channel
+from .registry import Format, channel_list, channel_metadata, choose_channel, names_height
 
 FORMAT = Format(
     "gwy",
@@ -48,14 +49,13 @@ FORMAT = Format(
     magic=(b"GWYP",),
     writes=True,
     carries=("spacing", "units", "metadata", "channels", "mask", "history"),
-    library="gwyfile",
+    write_library="gwyfile",
 )
 
 MAGIC = b"GWYP"
 MAX_DEPTH = 32
 SCALARS = {"b": "<B", "c": "<c", "i": "<i", "q": "<q", "d": "<d"}
 ARRAYS = {"C": "<u1", "I": "<i4", "Q": "<i8", "D": "<f8"}
-HEIGHT = re.compile(r"height|topo|z[- ]?axis|z[- ]?sensor|^z\b", re.IGNORECASE)
 OTHER = re.compile(r"deflection|amplitude|phase|friction|force|current|error|intensity|frequency", re.IGNORECASE)
 
 
@@ -140,7 +140,7 @@ def _default(titles, fields):
     """The first channel titled as a height, else the first in a length unit (or none) not titled as another
     quantity; FormatError listing the channels when there is none."""
     for index, title in enumerate(titles):
-        if HEIGHT.search(title):
+        if names_height(title):
             return index
     for index, (title, field) in enumerate(zip(titles, fields.values())):
         if not OTHER.search(title) and _is_length(field.get("si_unit_z")):
@@ -271,8 +271,6 @@ def _value(data, code, position, end, depth):
 
 
 def write(surface, stream):
-    from ..extras import require
-
     objects = require("gwyfile").objects
     heights = np.atleast_2d(surface.heights)
     valid = ~np.isnan(heights)

@@ -19,10 +19,11 @@ import io
 import numpy as np
 
 from ..errors import FormatError, InputError
+from ..extras import require
 from ..surface import Surface, Units, check_size
 from ..units import metres_per
 from . import limits
-from .registry import Format, channel_metadata, choose_channel
+from .registry import Format, channel_metadata, choose_channel, names_height
 
 FORMAT = Format(
     "hdf5",
@@ -30,15 +31,11 @@ FORMAT = Format(
     (".h5", ".hdf5", ".hdf"),
     magic=(b"\x89HDF\r\n\x1a\n",),
     carries=("units", "channels"),
-    library="h5py",
+    read_library="h5py",
 )
-
-HEIGHT_WORDS = ("height", "topography", "surface")
 
 
 def read(data, options):
-    from ..extras import require
-
     h5py = require("h5py")
     try:
         with h5py.File(io.BytesIO(bytes(data)), "r") as handle:
@@ -95,7 +92,7 @@ def _datasets(h5py, handle):
 
 def _default(names):
     for index, name in enumerate(names):
-        if any(word in name.rsplit("/", 1)[-1].casefold() for word in HEIGHT_WORDS):
+        if names_height(name.rsplit("/", 1)[-1]):
             return index
     return 0
 

@@ -1,7 +1,7 @@
 """What the headers of instrument files share: ``[section]`` blocks of key-value
-lines, numbers checked with one-line errors, length units that may not be lengths,
-the member names of a zip, the first tags of a TIFF, and a library kept quiet while it
-parses a damaged file."""
+lines, numbers checked with one-line errors, length units that may not be lengths, a
+file's length checked against what its header describes, the member names of a zip,
+the first tags of a TIFF, and a library kept quiet while it parses a damaged file."""
 
 import contextlib
 import logging
@@ -30,6 +30,25 @@ def ini_sections(text, separator="="):
             key, _, value = line.partition(separator)
             current.setdefault(key.strip(), value.strip())
     return found
+
+
+def check_length(data, end, title, contents):
+    """Refuse a file that is not the ``end`` bytes its header describes: shorter (the
+    data run past the end of the file) or longer (a damaged or misread header).
+    ``title`` names the format, ``contents`` what the header describes.
+
+    >>> check_length(bytes(12), 10, "BCR", "header and 2×1 points")
+    Traceback (most recent call last):
+    ...
+    rough.errors.FormatError: BCR file holds 12 bytes, its header describes 10 (header and 2×1 points)
+    """
+    if end > len(data):
+        raise FormatError(
+            f"{title} data runs past the end of the file: it holds {len(data):,} bytes, "
+            f"its header describes {end:,} ({contents})"
+        )
+    if end < len(data):
+        raise FormatError(f"{title} file holds {len(data):,} bytes, its header describes {end:,} ({contents})")
 
 
 def header_number(fields, key, what, default=None):

@@ -27,6 +27,7 @@ import struct
 import numpy as np
 
 from ..errors import FormatError
+from ..extras import require
 from ..surface import Surface, Units, check_size
 from .header import metres_or_none, quiet
 from .registry import Format, channel_list, channel_metadata, choose_channel
@@ -58,13 +59,11 @@ FORMAT = Format(
     probe=probe,
     by_extension=True,
     carries=("spacing", "units", "metadata", "time", "channels"),
-    library="igor2",
+    read_library="igor2",
 )
 
 
 def read(data, options):
-    from ..extras import require
-
     binarywave = require("igor2.binarywave")
     data = bytes(data)
     if not probe(data[:512]):

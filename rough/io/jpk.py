@@ -22,21 +22,20 @@ stored when reflected; checked with Gwyddion 2 on TIFFs written both ways).
 """
 
 import io
-import re
 
 import numpy as np
 
 from ..errors import FormatError
+from ..extras import require
 from ..surface import Surface, Units, check_size
 from .header import first_tiff_tags, metres_or_none, quiet
-from .registry import Format, channel_list, channel_metadata, choose_channel
+from .registry import Format, channel_list, channel_metadata, choose_channel, names_height
 
 START_DATE, GRID_U, GRID_V, GRID_REFLECT = 0x8003, 0x8042, 0x8043, 0x8045
 CHANNEL, RETRACE, FANCY_NAME, SLOT_COUNT, DEFAULT_SLOT = 0x8050, 0x8051, 0x8052, 0x8080, 0x8081
 SLOTS, SLOT_STRIDE = 0x8090, 0x30
 SLOT_NAME, ENCODER_UNIT, SCALING_TYPE, MULTIPLY, OFFSET = 0x00, 0x12, 0x13, 0x14, 0x15
 MAX_SLOTS = 64
-HEIGHT = re.compile(r"height|topograph", re.IGNORECASE)
 
 
 def probe(head):
@@ -51,13 +50,11 @@ FORMAT = Format(
     magic=(b"MM\0*", b"II*\0"),
     probe=probe,
     carries=("spacing", "units", "metadata", "time", "channels"),
-    library="tifffile",
+    read_library="tifffile",
 )
 
 
 def read(data, options):
-    from ..extras import require
-
     tifffile = require("tifffile")
     data = bytes(data)
     try:
@@ -120,7 +117,7 @@ def _default_slot(tags, name):
 
 def _default(channels, names):
     for index, channel in enumerate(channels):
-        if HEIGHT.search(_text(channel["tags"].get(CHANNEL))) or HEIGHT.search(channel["name"]):
+        if names_height(_text(channel["tags"].get(CHANNEL))) or names_height(channel["name"]):
             return index
     if not channels:
         raise FormatError("JPK file holds no channel in a length unit (no height channel)")

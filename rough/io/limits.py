@@ -94,45 +94,6 @@ class Budget:
             )
 
 
-def read_capped(stream, what, is_text=None):
-    """All of ``stream``, read in chunks, refused past MAX_INPUT_BYTES, and past
-    MAX_TEXT_BYTES once its first bytes show text (``is_text(head)``, asked with up
-    to :data:`rough.io.registry.HEAD` bytes): the cap applies while the bytes arrive,
-    so a stream is never read further than it. A zip archive comes back as a read-only
-    memoryview, hashed as it arrived (rough.io.x3p.receive)."""
-    limit = cap("MAX_INPUT_BYTES")
-    from .registry import HEAD
-    from .x3p import receive
-
-    received = receive(stream, what, limit)
-    if received is not None:
-        return received
-    size = file_size(stream)
-    if size is not None:
-        if size > limit:
-            raise _too_large(what, limit)
-        start = stream.tell()
-        if is_text is not None and size - start > cap("MAX_TEXT_BYTES") and is_text(stream.read(HEAD)):
-            raise too_much_text(size - start)
-        stream.seek(start)
-        return stream.read()
-    parts, total, ceiling, text = [], 0, limit, None if is_text else False
-    while part := stream.read(min(HEAD if text is None else CHUNK << 4, ceiling + 1 - total)):
-        parts.append(part)
-        total += len(part)
-        if text is None and total >= HEAD:
-            text = is_text(b"".join(parts)[:HEAD])
-            ceiling = min(limit, cap("MAX_TEXT_BYTES")) if text else limit
-        if total > limit:
-            raise _too_large(what, limit)
-        if total > ceiling:
-            raise too_much_text(None)
-    data = b"".join(parts)
-    if text is None and total > cap("MAX_TEXT_BYTES") and is_text(data):
-        raise too_much_text(total)
-    return data
-
-
 def too_much_text(size):
     """The refusal of text past MAX_TEXT_BYTES (``size`` bytes, None for a stream
     refused as it arrived)."""
@@ -155,7 +116,7 @@ def file_size(stream):
     return status.st_size if stat.S_ISREG(status.st_mode) else None
 
 
-def _too_large(what, limit):
+def too_large(what, limit):
     return InputError(f"{what}: larger than {human(limit)}; refusing (set ROUGH_MAX_INPUT_BYTES to raise the cap)")
 
 

@@ -22,6 +22,7 @@ import numpy as np
 
 from ..errors import FormatError
 from ..surface import Surface, Units, check_size
+from .header import check_length
 from .registry import Format
 
 FORMAT = Format(
@@ -46,13 +47,7 @@ def read(data, options):
     check_size((ny, nx), "the MetroPro phase map")
     offset = header["header_size"] + 2 * header["ac_n_buckets"] * header["ac_width"] * header["ac_height"]
     end = offset + 4 * nx * ny
-    if end > len(data):
-        raise FormatError(f"MetroPro phase data of {nx}×{ny} points runs past the end of the file")
-    if end < len(data):
-        raise FormatError(
-            f"MetroPro file holds {len(data):,} bytes, its header describes {end:,} "
-            f"(intensity, then {nx}×{ny} phase points)"
-        )
+    check_length(data, end, "MetroPro", f"header, intensity, then {nx}×{ny} phase points")
     phase = np.frombuffer(data, ">i4", nx * ny, offset).reshape(ny, nx)
     heights = np.where(phase >= INVALID_PHASE, np.nan, phase * _height_scale(header))
     return Surface(heights, _spacing(header), units=Units(xy="m", z="m"), metadata=_metadata(header))

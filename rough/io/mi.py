@@ -21,7 +21,7 @@ import numpy as np
 
 from ..errors import FormatError
 from ..surface import Surface, Units, check_size
-from .header import header_count, header_number, metres_or_none
+from .header import check_length, header_count, header_number, metres_or_none
 from .registry import Format, channel_list, channel_metadata, choose_channel
 
 FORMAT = Format(
@@ -43,16 +43,7 @@ def read(data, options):
     check_size((ny, nx), "the MI image")
     dtype = np.dtype(TYPES[encoding])
     block = nx * ny * dtype.itemsize
-    if start + block * len(channels) > len(data):
-        raise FormatError(
-            f"MI file holds {len(data) - start} data bytes, fewer than {len(channels)} channels of "
-            f"{nx}×{ny} points need ({block * len(channels)} bytes)"
-        )
-    if start + block * len(channels) < len(data):
-        raise FormatError(
-            f"MI file holds {len(data):,} bytes, its header describes {start + block * len(channels):,} "
-            f"(header and {len(channels)} channels of {nx}×{ny} points)"
-        )
+    check_length(data, start + block * len(channels), "MI", f"header and {len(channels)} channels of {nx}×{ny} points")
     names = [channel["bufferLabel"] for channel in channels]
     units = [metres_or_none(channel.get("bufferUnit", "")) for channel in channels]
     default = next((index for index, metres in enumerate(units) if metres is not None), 0)

@@ -55,7 +55,7 @@ FORMAT = Format(
     (".mnt",),
     magic=(b"\xd0\xcf\x11\xe0\xa1\xb1\x1a\xe1",),
     carries=("spacing", "units", "metadata", "mask"),
-    library="olefile",
+    read_library="olefile",
 )
 
 ENTRY = struct.Struct("<HQ")

@@ -33,7 +33,7 @@ FORMAT = Format(
 
 
 def read(data, options):
-    from scipy.io import netcdf_file
+    from scipy.io import netcdf_file  # start-up: only NetCDF loads scipy.io (the sniffer imports every format)
 
     try:
         with netcdf_file(io.BytesIO(bytes(data)), "r", mmap=False, maskandscale=False) as nc:

@@ -18,7 +18,6 @@ Orientation: row 0 is the last line stored, as Gwyddion and SurfaceTopography sh
 """
 
 import datetime
-import re
 
 import numpy as np
 
@@ -26,7 +25,7 @@ from ..errors import FormatError
 from ..surface import Surface, Units, check_size
 from ..units import metres_per
 from .header import header_count, header_number, ini_sections, length_unit, metres_or_none
-from .registry import Format, channel_list, channel_metadata, choose_channel
+from .registry import Format, channel_list, channel_metadata, choose_channel, names_height
 
 FORMAT = Format(
     "nid",
@@ -38,7 +37,6 @@ FORMAT = Format(
 
 DATA_MAGIC = b"\n#!"
 MAX_GROUPS = 1000
-HEIGHT = re.compile(r"z[- ]?axis|z[- ]?sensor|topograph|height|^z$", re.IGNORECASE)
 
 
 def read(data, options):
@@ -69,7 +67,7 @@ def read(data, options):
 def _default(channels, names):
     """The first channel whose quantity (``Dim2Name``) is a height; FormatError when there is none."""
     for index, channel in enumerate(channels):
-        if HEIGHT.search(channel["fields"].get("Dim2Name", "")):
+        if names_height(channel["fields"].get("Dim2Name")):
             return index
     raise FormatError(
         f"NID file holds no height channel (Z-Axis, Topography): its length channels {channel_list(names)} "

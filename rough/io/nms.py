@@ -25,6 +25,7 @@ import numpy as np
 
 from ..errors import FormatError
 from ..surface import Surface, Units, check_size
+from .header import check_length
 from .registry import Format
 
 FORMAT = Format(
@@ -50,13 +51,7 @@ def read(data, options):
     if nx == 0 or ny == 0:
         raise FormatError(f"NMS image of {nx}×{ny} points is empty")
     check_size((ny, nx), "the NMS height image")
-    if HEADER_SIZE + 2 * nx * ny > len(data):
-        raise FormatError(f"NMS height image of {nx}×{ny} points runs past the end of the file")
-    if HEADER_SIZE + 3 * nx * ny != len(data):
-        raise FormatError(
-            f"NMS file holds {len(data):,} bytes, its header describes {HEADER_SIZE + 3 * nx * ny:,} "
-            f"(header, {nx}×{ny} uint16 heights and uint8 intensities)"
-        )
+    check_length(data, HEADER_SIZE + 3 * nx * ny, "NMS", f"header, {nx}×{ny} uint16 heights and uint8 intensities")
     if not (np.isfinite(zmin) and np.isfinite(zmax) and zmax >= zmin):
         raise FormatError(f"NMS z range {zmin!r} … {zmax!r} µm is not a range")
     for name, step in (("dx", dx), ("dy", dy)):

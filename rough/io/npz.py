@@ -10,11 +10,11 @@ Channels: the 2-D numeric members, in the archive's order. An archive without on
 is a profile, its channels the 1-D numeric members (a member named ``x…`` of the
 profile's length is its x axis, not a channel). ``--channel`` takes a name (without
 ``.npy``, any case) or a number from 0. The default is the raw height array: the
-first member whose name, split at anything not a letter, holds a height word (``z``,
-``height``, ``topography``, ``surface``, ``elevation``, ``dem``) and no word of
-processing (``detrended``, ``levelled``, ``filtered``, ``residual``, …); else the
-first with a height word; else the first. rough removes form itself, so the raw
-heights are the honest default (``Z_grid`` before ``Z_detrended``).
+first member whose name says height (:data:`rough.io.registry.HEIGHT_NAME`: ``z``
+as a word, ``height``, ``topography``, ``surface``, ``elevation``, ...) and, split at
+anything not a letter, holds no word of processing (``detrended``, ``levelled``,
+``filtered``, ``residual``, …); else the first that says height; else the first.
+rough removes form itself, so the raw heights are the honest default (``Z_grid`` before ``Z_detrended``).
 
 Spacing and origin, per axis: a scalar member ``dx`` (``dy``), else a 1-D axis
 member named ``x…`` (``y…``: ``x``, ``xg``, ``x_axis``) as long as the columns
@@ -34,9 +34,9 @@ import numpy as np
 
 from ..errors import FormatError
 from ..surface import Surface, Units, check_size
+from . import ziparchive
 from .header import zip_names
-from .registry import Format, channel_metadata, choose_channel
-from .x3p import ZIP_ERRORS, _member, _ViewFile
+from .registry import Format, channel_metadata, choose_channel, names_height
 
 FORMAT = Format(
     "npz",
@@ -47,7 +47,6 @@ FORMAT = Format(
     carries=("spacing", "channels"),
 )
 
-HEIGHT_WORDS = {"z", "height", "heights", "topography", "surface", "elevation", "dem"}
 PROCESSED_WORDS = {"detrended", "levelled", "leveled", "filtered", "flattened", "residual", "residuals", "fitted"}
 HEADER_BYTES = 1 << 16  # an NPY header is at most this long here
 AXIS_TOLERANCE = 1e-6  # of the step: how far an axis may stray from equal spacing
@@ -59,9 +58,9 @@ def _holds_npy(names):
 
 def read(data, options):
     try:
-        archive = zipfile.ZipFile(_ViewFile(data))
+        archive = zipfile.ZipFile(ziparchive.ViewFile(data))
         headers = {info.filename[: -len(".npy")]: (info, _header(archive, info)) for info in _members(archive)}
-    except (*ZIP_ERRORS, ValueError) as error:
+    except (*ziparchive.ZIP_ERRORS, ValueError) as error:
         raise FormatError(f"not a readable NPZ archive ({error})") from None
     numeric = {name: found for name, found in headers.items() if found[1] is not None}
     maps = [name for name, (_, header) in numeric.items() if len(header[0]) == 2]
@@ -92,10 +91,9 @@ def default_channel(names):
     """
 
     def rank(index):
-        words = set(re.split(r"[^a-z]+", names[index].casefold()))
-        if not words & HEIGHT_WORDS:
+        if not names_height(names[index]):
             return 2, index
-        return (1 if words & PROCESSED_WORDS else 0), index
+        return (1 if set(re.split(r"[^a-z]+", names[index].casefold())) & PROCESSED_WORDS else 0), index
 
     return min(range(len(names)), key=rank)
 
@@ -127,7 +125,7 @@ def _header(archive, info):
 def _array(archive, data, found):
     """A member's numbers, after checking it holds exactly what its NPY header declares."""
     info, (shape, fortran, dtype, offset) = found
-    content = _member(archive, info.filename, data)
+    content = ziparchive.member(archive, info.filename, data)
     count = int(np.prod(shape, dtype=object))
     if count * dtype.itemsize != len(content) - offset:
         raise FormatError(

@@ -20,6 +20,7 @@ import struct
 import numpy as np
 
 from ..errors import FormatError
+from ..extras import require
 from ..surface import Surface, Units, check_size
 from .header import first_tiff_tags, length_unit, quiet
 from .registry import Format, channel_metadata
@@ -45,13 +46,11 @@ FORMAT = Format(
     magic=(b"II*\0", b"MM\0*"),
     probe=probe,
     carries=("spacing", "units", "metadata", "time"),
-    library="tifffile",
+    read_library="tifffile",
 )
 
 
 def read(data, options):
-    from ..extras import require
-
     tifffile = require("tifffile")
     tags = _tags(tifffile, bytes(data))
     if tags.get(TAG_MAGIC) != MAGIC:

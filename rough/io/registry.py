@@ -3,19 +3,34 @@
 A format module (``rough/io/<module>.py``) holds ``FORMAT = Format(...)`` and a
 ``read(data, options)`` that turns a whole file's bytes into a :class:`~rough.Surface`;
 it may add ``read_path(path, options)`` (formats read piecewise from disk, such as
-GeoTIFF windows) and ``write(surface, stream)``. :data:`MODULES` lists the modules in
-sniffing order. The sniffer, the readers and writers table, the ``-f`` choices,
-``rough formats``, the docs' format table and the error messages all come from here.
+GeoTIFF windows) and ``write(surface, stream)``. :data:`MODULES` lists the built-in
+modules in sniffing order. The sniffer, the readers and writers table, the ``-f``
+choices, ``rough formats``, the docs' format table and the error messages all come
+from :func:`formats`.
+
+Plugins: another package adds a format with a module laid out the same way, named
+by an entry point of the group ``rough.formats`` (:func:`rough.plugins.entry_points`).
+The sniffer asks the plugins after the built-in formats of :data:`MODULES` and before
+the generic fallbacks of :data:`FALLBACKS` (text, which takes any plain text), in the
+order of their entry-point names. A built-in name wins over a plugin's; a plugin that
+fails to import, or declares no ``FORMAT`` and ``read``, is left out with a one-line
+warning naming it.
 """
 
 import dataclasses
 import functools
 import importlib
+import importlib.util
+import logging
 import os
+import re
 
 from ..errors import FormatError
+from ..plugins import entry_points
 
-#: Format modules, in the order the sniffer asks them (specific magic before generic).
+log = logging.getLogger("rough")
+
+#: Built-in format modules, in the order the sniffer asks them (specific magic before generic).
 MODULES = (
     "xlsx",
     "nmm",
@@ -48,12 +63,15 @@ MODULES = (
     "geotiff",
     "ibw",
     "plu",
-    "text",
 )
+
+#: Built-in modules that take what no other format claims, asked last (after plugins).
+FALLBACKS = ("text",)
 
 #: What a format can carry, as ``Format.carries`` names it.
 CARRIES = {
     "spacing": "lateral spacing",
+    "exact-grid": "exact spacing and origin",
     "units": "units",
     "metadata": "instrument metadata",
     "time": "acquisition time",
@@ -63,6 +81,15 @@ CARRIES = {
     "history": "rough's history",
     "crs": "coordinate reference system",
 }
+
+#: What names a height channel, in any reader's channel names or titles: a height,
+#: topography, a z axis or sensor, a surface (not a Kelvin probe's surface potential) or
+#: elevation (model), or ``z`` as a word (split at anything not a letter: ``Z``,
+#: ``Z_grid``, ``z-data``).
+HEIGHT_NAME = re.compile(
+    r"height|topo|z[- ]?axis|z[- ]?sensor|surface(?![- _]?potential)|elevation|(?<![a-z])(z|dem)(?![a-z])",
+    re.IGNORECASE,
+)
 
 #: Vendor extensions rough does not read: name → instrument or program.
 UNREAD_EXTENSIONS = {
@@ -87,17 +114,35 @@ UNREAD_EXTENSIONS = {
 class Format:
     """The facts of one file format.
 
-    name: the short key (``-f`` choice, ``Surface.source_format``).
-    title: what people call it (``"Digital Surf SUR"``).
-    extensions: file name endings, lower case with the dot; the first is the one written.
-    magic: byte strings a file starts with; ``(offset, bytes)`` pairs for magic further in.
-    probe: ``probe(head) -> bool`` on the first :data:`HEAD` bytes, for formats whose
-        magic is shared or absent (it is asked after the magic matched, if there is one).
-    by_extension: the format has no reliable magic and is also chosen by its extension.
-    writes: rough writes it.
-    carries: keys of :data:`CARRIES`.
-    library: the PyPI distribution its reader needs, if any (an extra of rough's).
-    binary: a written file is binary (refused on a terminal).
+    Attributes
+    ----------
+    name : str
+        The short key (``-f`` choice, ``Surface.source_format``).
+    title : str
+        What people call it (``"Digital Surf SUR"``).
+    extensions : tuple of str
+        File name endings, lower case with the dot; the first is the one written.
+    magic : tuple
+        Byte strings a file starts with; ``(offset, bytes)`` pairs for magic further in.
+    probe : callable, optional
+        ``probe(head) -> bool`` on the first :data:`HEAD` bytes, for formats whose magic
+        is shared or absent (it is asked after the magic matched, if there is one).
+    by_extension : bool
+        The format has no reliable magic and is also chosen by its extension.
+    writes : bool
+        rough writes it.
+    writes_profiles : bool
+        rough writes profiles in it too, not only maps.
+    height_type : str
+        The type a written file holds its heights in (``"float32"``: they come back
+        rounded to float32).
+    carries : tuple of str
+        Keys of :data:`CARRIES`.
+    read_library, write_library : str or None
+        The module reading (writing) needs beyond rough's core, if any (an extra of
+        rough's, :data:`rough.extras.EXTRAS`).
+    binary : bool
+        A written file is binary (refused on a terminal).
     """
 
     name: str
@@ -107,8 +152,11 @@ class Format:
     probe: object = None
     by_extension: bool = False
     writes: bool = False
+    writes_profiles: bool = True
+    height_type: str = "float64"
     carries: tuple = ()
-    library: str = None
+    read_library: str = None
+    write_library: str = None
     binary: bool = True
 
     def matches(self, head):
@@ -128,13 +176,43 @@ def _starts(head, magic):
 
 
 @functools.cache
+def _built_in():
+    """``{format name: module}`` of :data:`MODULES` then :data:`FALLBACKS`: what a file
+    a built-in format claims needs, without looking for plugins."""
+    return {format_module.FORMAT.name: format_module for format_module in map(module, (*MODULES, *FALLBACKS))}
+
+
+@functools.cache
 def _modules():
-    """``{format name: module}`` in sniffing order."""
-    table = {}
-    for module_name in MODULES:
-        format_module = module(module_name)
-        table[format_module.FORMAT.name] = format_module
-    return table
+    """``{format name: module}`` in sniffing order: :data:`MODULES`, the plugins,
+    :data:`FALLBACKS`."""
+    first = [module(name) for name in MODULES]
+    last = [module(name) for name in FALLBACKS]
+    taken = set(_built_in())
+    plugins = []
+    for point, value in entry_points("rough.formats").items():
+        plugin = _plugin(point, value)
+        if plugin is not None and plugin.FORMAT.name in taken:
+            owner = "rough has" if plugin.FORMAT.name in _built_in() else "an earlier plugin has"
+            log.warning("format plugin %s (%s) left out: %s a format named %r", point, value, owner, plugin.FORMAT.name)
+        elif plugin is not None:
+            taken.add(plugin.FORMAT.name)
+            plugins.append(plugin)
+    return {format_module.FORMAT.name: format_module for format_module in (*first, *plugins, *last)}
+
+
+def _plugin(point, value):
+    """The module a ``rough.formats`` entry point names, or None (with a one-line
+    warning) when it fails to import or is not laid out as a format module."""
+    try:
+        plugin = importlib.import_module(value.partition(":")[0])
+    except Exception as error:  # noqa: BLE001 -- any failure of a third-party import leaves the plugin out
+        log.warning("format plugin %s (%s) left out: %s: %s", point, value, type(error).__name__, error)
+        return None
+    if not isinstance(getattr(plugin, "FORMAT", None), Format) or not callable(getattr(plugin, "read", None)):
+        log.warning("format plugin %s (%s) left out: it declares no FORMAT = Format(...) and read()", point, value)
+        return None
+    return plugin
 
 
 @functools.cache
@@ -145,7 +223,7 @@ def formats():
 
 def module_of(name):
     """The module that reads and writes format ``name``; KeyError for an unknown name."""
-    return _modules()[name]
+    return _built_in()[name] if name in _built_in() else _modules()[name]
 
 
 def module(module_name):
@@ -169,13 +247,23 @@ def sniff(head, name=None):
     """The format name of a file from its first bytes (and, for formats without a
     magic number, its name's extension). Raises FormatError naming what rough reads."""
     head, extension = bytes(head[:HEAD]), _extension(name)
-    table = formats().values()
-    matched = next((facts for facts in table if facts.matches(head)), None)
+    built_in = (module(module_name).FORMAT for module_name in MODULES)
+    matched = next((facts for facts in built_in if facts.matches(head)), None)
+    if matched is None:  # plugins come after the built-ins: looked for only now
+        table = formats().values()
+        matched = next((facts for facts in table if facts.matches(head)), None)
     if matched is None:
         matched = next((facts for facts in table if facts.by_extension and extension in facts.extensions), None)
-    if matched is None or (extension in UNREAD_EXTENSIONS and extension not in matched.extensions):
-        raise FormatError(unrecognised(name))  # a zip, HDF5 or TIFF holding a format rough does not read
+    if matched is not None and extension in UNREAD_EXTENSIONS and extension not in matched.extensions:
+        # a zip, HDF5 or TIFF container holding a vendor's format: only a plugin may read it
+        matched = next((facts for facts in formats().values() if _claims(facts, head, extension)), None)
+    if matched is None:
+        raise FormatError(unrecognised(name))
     return matched.name
+
+
+def _claims(facts, head, extension):
+    return extension in facts.extensions and (facts.by_extension or facts.matches(head))
 
 
 def unrecognised(name=None):
@@ -225,6 +313,15 @@ def choose_channel(names, wanted, default=0):
     raise FormatError(f"no channel {wanted!r}; the file holds {channel_list(names)}")
 
 
+def names_height(name):
+    """Whether a channel's name or title says it holds heights (:data:`HEIGHT_NAME`).
+
+    >>> [names_height(name) for name in ("ZSensor", "Z_grid", "Topography", "Phase", "Surface potential")]
+    [True, True, True, False, False]
+    """
+    return bool(HEIGHT_NAME.search(name or ""))
+
+
 def channel_list(names):
     """``"0 'ZSensor', 1 'Phase'"``: channels as ``info`` and messages list them."""
     return ", ".join(f"{index} {name!r}" for index, name in enumerate(names))
@@ -235,17 +332,25 @@ def channel_metadata(names, index):
     return {"channel": names[index], "channels": channel_list(names)}
 
 
+def describe(format_name):
+    """What people call a format (``"Digital Surf SUR"``), from its key."""
+    built_in = _built_in().get(format_name)
+    facts = built_in.FORMAT if built_in else formats().get(format_name)
+    return facts.title if facts else format_name
+
+
 def table():
     """Every format as a dict: ``name``, ``title``, ``extensions``, ``read`` (always
-    True), ``write``, ``carries`` (keys of :data:`CARRIES`), ``library`` and whether that
-    library is ``installed``.
+    True), ``write``, ``carries`` (keys of :data:`CARRIES`), ``read_library`` and
+    ``write_library`` (the modules reading and writing need beyond rough's core, or
+    None) and whether they are ``installed``.
 
     >>> rows = {row["name"]: row for row in table()}
     >>> rows["x3p"]["write"], rows["x3p"]["extensions"]
     (True, ['.x3p'])
+    >>> rows["gwy"]["read_library"], rows["gwy"]["write_library"]
+    (None, 'gwyfile')
     """
-    import importlib.util
-
     return [
         {
             "name": facts.name,
@@ -254,8 +359,13 @@ def table():
             "read": True,
             "write": facts.writes,
             "carries": list(facts.carries),
-            "library": facts.library,
-            "installed": facts.library is None or importlib.util.find_spec(facts.library) is not None,
+            "read_library": facts.read_library,
+            "write_library": facts.write_library,
+            "installed": all(_installed(library) for library in (facts.read_library, facts.write_library)),
         }
         for facts in formats().values()
     ]
+
+
+def _installed(library):
+    return library is None or importlib.util.find_spec(library) is not None

@@ -18,7 +18,7 @@ import math
 import numpy as np
 
 from ..errors import FormatError, InputError
-from ..surface import Surface, Units, history_entry
+from ..surface import Surface, Units, check_size, history_entry
 
 TOLERANCE = 1e-3  # of a step
 METHODS = ("linear", "bandlimited")
@@ -103,8 +103,6 @@ def regrid(x, z, spacing, method="linear"):
     count = int(np.floor((x[-1] - x[0]) / spacing * (1 + 1e-12))) + 1
     if count < 2:
         raise FormatError(f"a regrid spacing of {spacing:.6g} m leaves fewer than two points")
-    from ..surface import check_size
-
     check_size((count,), "the regridded profile")
     valid = np.isfinite(z)
     target = x[0] + spacing * np.arange(count)

@@ -67,7 +67,7 @@ FORMAT = Format(
     (".tsv", ".txt"),
     probe=_looks_like_text,
     writes=True,
-    carries=("spacing", "units", "metadata", "mask", "history"),
+    carries=("spacing", "exact-grid", "units", "metadata", "mask", "history"),
     binary=False,
 )
 

@@ -16,6 +16,7 @@ import numpy as np
 
 from ..errors import FormatError
 from ..surface import Surface, Units, check_size
+from .header import check_length
 from .registry import Format
 
 FORMAT = Format(
@@ -37,13 +38,7 @@ def read(data, options):
         raise FormatError(f"TMD grid of {nx} × {ny} points is empty")
     check_size((ny, nx), "the TMD map")
     start = position + 24
-    if start + nx * ny * 4 > len(data):
-        raise FormatError(f"TMD heights of {nx} × {ny} points run past the end of the file")
-    if start + nx * ny * 4 < len(data):
-        raise FormatError(
-            f"TMD file holds {len(data):,} bytes, its header describes {start + nx * ny * 4:,} "
-            f"(header and {nx} × {ny} float32 heights)"
-        )
+    check_length(data, start + nx * ny * 4, "TMD", f"header and {nx} × {ny} float32 heights")
     for name, length in (("x", length_x), ("y", length_y)):
         if not 0 < length < np.inf:
             raise FormatError(f"TMD {name} length is {length!r} µm, not a positive length")

@@ -25,15 +25,13 @@ Orientation: as Gwyddion, which reverses both axes of the stored data (its write
 is the last line stored, column 0 the last column. SurfaceTopography keeps the stored order.
 """
 
-import re
-
 import numpy as np
 
 from ..errors import FormatError, InputError
 from ..surface import Surface, Units, check_size
 from ..units import metres_per
-from .header import ini_sections
-from .registry import Format, choose_channel
+from .header import check_length, ini_sections
+from .registry import Format, choose_channel, names_height
 
 FORMAT = Format(
     "wsxm",
@@ -44,7 +42,6 @@ FORMAT = Format(
 )
 
 END = b"[Header end]"
-HEIGHT = re.compile(r"topo|height|^z\b", re.IGNORECASE)
 TYPES = {"short": "<i2", "integer": "<i2", "float": "<f4", "double": "<f8"}
 
 
@@ -65,13 +62,7 @@ def read(data, options):
     if kind not in TYPES:
         raise FormatError(f"WSxM Image Data Type {kind!r} is not short, integer, float or double")
     dtype = np.dtype(TYPES[kind])
-    if start + nx * ny * dtype.itemsize > len(data):
-        raise FormatError(f"WSxM image of {nx}×{ny} {kind} values runs past the end of the file ({len(data)} bytes)")
-    if start + nx * ny * dtype.itemsize < len(data):
-        raise FormatError(
-            f"WSxM file holds {len(data):,} bytes, its header describes {start + nx * ny * dtype.itemsize:,} "
-            f"(header and {nx}×{ny} {kind} values)"
-        )
+    check_length(data, start + nx * ny * dtype.itemsize, "WSxM", f"header and {nx}×{ny} {kind} values")
     raw = np.ndarray((ny, nx), dtype, data, start)[::-1, ::-1].astype(np.float64)
     amplitude, z_unit = _length(info, "Z Amplitude")
     control = sections.get("Control", {})
@@ -86,7 +77,7 @@ def read(data, options):
 
 def _check_height(channel, options):
     """FormatError for a file whose ``Acquisition channel`` is not a height, unless ``--channel`` names it."""
-    if channel is None or HEIGHT.search(channel):
+    if channel is None or names_height(channel):
         return
     if options.channel is None:
         raise FormatError(

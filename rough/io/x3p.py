@@ -36,41 +36,33 @@ with the data aligned to 64 bytes, and rough's units, metadata and history in a
 vendor-specific member named by the root's ``VendorSpecificID``, which other readers
 ignore. Every local header carries its member's CRC-32 and sizes (no data
 descriptors, even on a pipe), so that the next reader knows where each member ends
-before it arrives; ZIP64 fields where a size or offset needs them.
+before it arrives; ZIP64 fields where a size or offset needs them
+(:class:`rough.io.ziparchive.ZipWriter`).
 
 Checksums, once per stage: the MD5 and the zip CRC-32 of ``bindata/data.bin`` are
 computed in one pass over its bytes. A stream (standard input, a file) is hashed as it
-arrives (:func:`receive`: the MD5 in a worker thread, as hashlib releases the GIL), so
-hashing overlaps reading. The MD5 is checked against main.xml (a mismatch refuses the
-file unless ``verify=False``); the CRC-32 is checked only where no MD5 is. Heights
+arrives (:func:`rough.io.receiving.receive`), so hashing overlaps reading. The MD5 is
+checked against main.xml (a mismatch refuses the file unless ``verify=False``); the
+CRC-32 is checked only where no MD5 is. Heights
 written unchanged reuse both (they view the read-only bytes they were checked on);
 other heights are hashed once when written, MD5 and CRC-32 at the same time.
 """
 
-import bz2
-import contextlib
 import hashlib
-import io
 import json
 import logging
-import lzma
-import mmap
-import os
-import queue
 import re
-import struct
-import threading
 import weakref
 import zipfile
-import zlib
 from xml.etree import ElementTree
 
 import numpy as np
 
 from .. import __version__
+from .. import io as rough_io  # lazy: rough.io.gridding (scipy) loads only when points are gridded
 from ..errors import FormatError
-from ..surface import Surface, Units, check_size, history_entry, timestamp
-from . import limits, provenance, regrid
+from ..surface import Surface, Units, timestamp
+from . import limits, provenance, receiving, regrid, ziparchive
 from .registry import Format
 
 FORMAT = Format(
@@ -79,34 +71,18 @@ FORMAT = Format(
     (".x3p",),
     magic=(b"PK\x03\x04", b"PK\x05\x06"),
     writes=True,
-    carries=("spacing", "units", "metadata", "time", "layers", "mask", "history"),
+    carries=("spacing", "exact-grid", "units", "metadata", "time", "layers", "mask", "history"),
 )
 
 NAMESPACE = "http://www.opengps.eu/2008/ISO5436_2"
 VENDOR_ID = "urn:x-rough:x3p-vendor:1"
 VENDOR_MEMBER = "vendor/rough.json"
 DATA_TYPES = {"I": "<i2", "L": "<i4", "F": "<f4", "D": "<f8"}
-# What zipfile raises for damaged or unusual archives (bz2 raises OSError, lzma LZMAError)
-ZIP_ERRORS = (
-    zipfile.BadZipFile,
-    zipfile.LargeZipFile,
-    NotImplementedError,
-    RuntimeError,
-    OSError,
-    EOFError,
-    zlib.error,
-    lzma.LZMAError,
-)
 MAX_POINTS = 1 << 31
 MAX_XML_BYTES = 1 << 31
 MAX_SIDE_BYTES = 1 << 26
 ALIGNMENT = 64
 ROTATION_TOLERANCE = 1e-6  # of a rotation matrix element
-RECEIVE_STEP = 1 << 21  # bytes asked of each read of a stream
-HASH_STEP = 1 << 20  # bytes hashed at a time (and the size below which hashing takes no thread)
-FIRST_CAPACITY = 1 << 24  # bytes first set aside for a stream of unknown length
-HASHED_FROM = 1 << 16  # stored members this large and up are hashed on the way in ...
-HASHED_AT_MOST = 4  # ... the first few of them (X3P has one or two large members)
 
 log = logging.getLogger("rough")
 
@@ -114,11 +90,11 @@ log = logging.getLogger("rough")
 def read(data, options):
     data = data if isinstance(data, bytes) else memoryview(data).cast("B")
     try:
-        archive = zipfile.ZipFile(_ViewFile(data))
-    except (*ZIP_ERRORS, ValueError) as error:
+        archive = zipfile.ZipFile(ziparchive.ViewFile(data))
+    except (*ziparchive.ZIP_ERRORS, ValueError) as error:
         raise FormatError(f"not a valid X3P zip archive ({error})") from None
     prefix, main_name = _find_main(archive)
-    document = _member(archive, main_name, data, limit=MAX_XML_BYTES)
+    document = ziparchive.member(archive, main_name, data, limit=MAX_XML_BYTES)
     root = _parse_xml(bytes(document))
     _check(options.verify, _main_checksum_problem(archive, prefix, root, document, data))
 
@@ -146,7 +122,7 @@ def read(data, options):
     digest = None
     if root.find("Record3/DataLink") is not None:
         records, valid, digest = _binary_records(archive, prefix, root, data, fields, count, options.verify)
-        stored = (_address(records), records.nbytes)  # where data.bin's bytes are
+        stored = (receiving.address(records), records.nbytes)  # where data.bin's bytes are
     elif root.find("Record3/DataList") is not None:
         records, valid = _list_records(root, fields, count)
     else:
@@ -158,7 +134,7 @@ def read(data, options):
 
     points = _Points(axes, records, valid, rotation, nx)
     if cloud:
-        placed = _gridded(*points.placed(), options, f"an X3P point cloud of {nx} points")
+        placed = rough_io.gridding.grid_points(*points.placed(), options, f"an X3P point cloud of {nx} points")
     elif ny == 1:
         placed = _profile(points, nx, options)
     else:
@@ -187,7 +163,7 @@ def write(surface, stream):
     data_md5, data_crc = _digests(heights, payload)
     document = _main_xml(surface, data_md5, mask and hashlib.md5(mask).hexdigest())
     vendor = json.dumps(provenance.parts(surface), indent=1).encode("utf-8")
-    archive = _ZipWriter(stream)
+    archive = ziparchive.ZipWriter(stream)
     archive.add("main.xml", document)
     archive.add("md5checksum.hex", f"{hashlib.md5(document).hexdigest()} *main.xml\n".encode())
     archive.add("bindata/data.bin", payload, crc=data_crc, align=ALIGNMENT)
@@ -195,215 +171,6 @@ def write(surface, stream):
         archive.add("bindata/valid.bin", mask)
     archive.add(VENDOR_MEMBER, vendor)
     archive.close()
-
-
-# -- receiving a stream ------------------------------------------------------------
-
-
-def receive(stream, what, limit):
-    """All of a binary stream (standard input, an open file) that starts as a zip
-    archive, as a read-only memoryview, or None for any other stream, which the caller
-    reads as usual. Refused (InputError) past ``limit`` bytes.
-
-    The bytes go into one buffer as they arrive, with no copy after the read, and the
-    data of each stored member whose local header gives its size are hashed on the
-    way: the CRC-32 in this thread, the MD5 in a worker thread, so hashing overlaps
-    the reading and ends soon after the last byte arrives. :func:`read` takes those
-    digests instead of hashing the data again."""
-    size = limits.file_size(stream)
-    try:  # a look at the first bytes that leaves a file's buffer empty (a later read() would join to it)
-        head = os.pread(stream.fileno(), 4, stream.tell()) if size is not None else stream.peek(4)[:4]
-        size = None if size is None else size - stream.tell()
-    except (AttributeError, OSError, ValueError):
-        return None
-    if head != b"PK\x03\x04" or not hasattr(stream, "readinto"):
-        return None
-    if size is not None and size > limit:
-        raise limits._too_large(what, limit)
-    try:
-        buffer = _Received(
-            -1, min(limit, FIRST_CAPACITY if size is None else size) + 1, flags=mmap.MAP_PRIVATE | mmap.MAP_ANONYMOUS
-        )  # private: a shared mapping cannot grow
-    except OSError:
-        raise MemoryError from None
-    with contextlib.suppress(AttributeError, OSError):  # 2 MiB pages: 1/512 of the faults while bytes arrive
-        buffer.madvise(mmap.MADV_HUGEPAGE)
-    headers, hasher = _LocalHeaders(), _Hasher()
-    view, filled = memoryview(buffer), 0
-    try:
-        while True:
-            if filled == len(buffer):
-                if filled > limit:
-                    raise limits._too_large(what, limit)
-                view = hasher.resize(buffer, view, min(limit + 1, 2 * filled))
-            count = stream.readinto(view[filled : filled + RECEIVE_STEP])
-            if not count:
-                break
-            filled += count
-            for start, end in headers.walk(view, filled):
-                hasher.add(start, end)
-            hasher.arrived(view, filled)
-            wanted = min(limit + 1, headers.horizon + headers.horizon // 16 + RECEIVE_STEP)
-            if size is None and wanted > len(buffer):  # the local headers tell how much more is coming
-                view = hasher.resize(buffer, view, wanted)
-        digests = hasher.finish()
-    finally:
-        hasher.stop()
-    view.release()
-    if filled < len(buffer):
-        buffer.resize(max(filled, 1))
-    received = memoryview(buffer).toreadonly()[:filled]
-    base = _address(received)
-    buffer.regions = {base + start: found for start, found in digests.items()}
-    return received
-
-
-class _Received(mmap.mmap):
-    """Anonymous memory (allocated as it is filled) holding a received stream.
-    ``regions`` maps the address of each stored member's data hashed on the way in to
-    ``(size, (MD5 hex, CRC-32))``."""
-
-    regions = {}
-
-
-def _address(data):
-    """Where a buffer's (or an array's) bytes start in memory."""
-    array = data if isinstance(data, np.ndarray) else np.frombuffer(data, np.uint8) if len(data) else None
-    return 0 if array is None else array.__array_interface__["data"][0]
-
-
-def _arrived(content):
-    """``(MD5 hex, CRC-32)`` of ``content`` if :func:`receive` hashed exactly these
-    bytes on the way in, else None."""
-    regions = getattr(getattr(content, "obj", None), "regions", None)
-    if not regions or not isinstance(content, memoryview):
-        return None
-    size, digests = regions.get(_address(content), (None, None))
-    return digests if size == len(content) else None
-
-
-class _LocalHeaders:
-    """Walks a zip archive's local headers as its bytes arrive. ``walk`` yields the
-    data ``(start, end)`` of the first few large stored members whose headers give
-    their size (:data:`HASHED_FROM`, :data:`HASHED_AT_MOST`: a hostile archive of a
-    million tiny members costs no more than an X3P file); the walk stops at anything
-    else (the central directory, a member followed by a data descriptor, ZIP64 sizes).
-    ``horizon`` is where the walk has got to."""
-
-    def __init__(self):
-        self.position, self.horizon, self.done, self.found = 0, 0, False, 0
-
-    def walk(self, view, filled):
-        while not self.done and self.position + LOCAL_HEADER.size <= filled:
-            signature, _, flags, method, _, _, _, packed, size, name, extra = LOCAL_HEADER.unpack_from(
-                view, self.position
-            )
-            if signature != b"PK\x03\x04" or flags & 0x8 or ZIP64_MARK in (packed, size):
-                self.done = True
-                break
-            start = self.position + LOCAL_HEADER.size + name + extra
-            if method == zipfile.ZIP_STORED and packed == size >= HASHED_FROM and not flags & 0x1:
-                if self.found < HASHED_AT_MOST:
-                    yield start, start + size
-                self.found += 1
-            self.position = self.horizon = start + packed
-
-
-class _Hasher:
-    """The MD5 and CRC-32 of regions of a buffer being filled, each byte hashed once,
-    as it arrives: the CRC-32 in the caller's thread, the MD5 in a worker thread (both
-    release the GIL on large buffers, so they run beside the reads)."""
-
-    def __init__(self):
-        self.regions = []  # [start, end, hashed up to, md5, crc]
-        self.jobs = queue.SimpleQueue()
-        self.worker = None
-        self.cancelled = self.failed = False
-
-    def add(self, start, end):
-        self.regions.append([start, end, start, hashlib.md5(), 0])
-
-    def arrived(self, view, filled):
-        for region in self.regions:
-            start, end, done, md5, crc = region
-            ready = min(end, filled)
-            if ready > done and (ready == end or ready - done >= HASH_STEP):
-                span = view[done:ready]
-                region[4] = zlib.crc32(span, crc)
-                region[2] = ready
-                if self.worker is None:
-                    self.worker = threading.Thread(target=self._work, name="rough-md5", daemon=True)
-                    self.worker.start()
-                self.jobs.put((md5, span))
-                del span
-
-    def _work(self):
-        while (job := self.jobs.get()) is not None:
-            try:
-                if callable(job):
-                    job()
-                elif not self.cancelled:
-                    job[0].update(job[1])
-            except Exception:  # noqa: BLE001 -- no digest then (the reader hashes again), and never a hang
-                self.cancelled = self.failed = True
-            job = None  # drop the view, so that the buffer can be resized
-
-    def resize(self, buffer, view, size):
-        """Grow the buffer (the kernel moves its pages, no copy) once the worker holds
-        no view of it; returns the new view."""
-        if self.worker is not None:
-            idle = threading.Event()
-            self.jobs.put(idle.set)
-            idle.wait()
-        view.release()
-        buffer.resize(size)
-        return memoryview(buffer)
-
-    def finish(self):
-        """``{start: (size, (MD5 hex, CRC-32))}`` of the regions that arrived whole."""
-        self._join()
-        if self.failed:
-            return {}
-        return {
-            start: (end - start, (md5.hexdigest(), crc)) for start, end, done, md5, crc in self.regions if done == end
-        }
-
-    def stop(self):
-        """Stop the worker without hashing what is still queued (after an error)."""
-        self.cancelled = True
-        self._join()
-
-    def _join(self):
-        if self.worker is not None and self.worker.is_alive():
-            self.jobs.put(None)
-            self.worker.join()
-
-
-class _ViewFile(io.RawIOBase):
-    """A read-only, seekable file over a buffer, for zipfile to find the central
-    directory in; io.BytesIO would copy anything but bytes."""
-
-    def __init__(self, data):
-        self.view, self.position = memoryview(data), 0
-
-    def readable(self):
-        return True
-
-    def seekable(self):
-        return True
-
-    def readinto(self, target):
-        part = self.view[self.position : self.position + len(target)]
-        target[: len(part)] = part
-        self.position += len(part)
-        return len(part)
-
-    def seek(self, offset, whence=io.SEEK_SET):
-        self.position = max(0, (0, self.position, len(self.view))[whence] + offset)
-        return self.position
-
-    def tell(self):
-        return self.position
 
 
 # -- reading -------------------------------------------------------------------------
@@ -419,77 +186,6 @@ def _find_main(archive):
         raise FormatError("a zip archive without main.xml, so not an X3P file; unpack it and read the files inside")
     main = min(candidates, key=len)
     return main[: -len("main.xml")], main
-
-
-def _member(archive, name, data, limit=None, expected=None, check_crc=True):
-    """A member's bytes; stored members are returned as a zero-copy view of ``data``
-    after their CRC is checked (unless the caller checks an MD5 of them instead).
-    Sizes are checked before anything is read."""
-    info, content = _located(archive, name, data, limit, expected)
-    if check_crc and zlib.crc32(content) != info.CRC:
-        raise FormatError(f"{name} fails its zip CRC check: the archive is damaged")
-    return content
-
-
-def _located(archive, name, data, limit=None, expected=None):
-    """``(zip entry, bytes)`` of a member, its CRC unchecked: a view of ``data`` for a
-    stored member, else the member unpacked."""
-    try:
-        info = archive.getinfo(name)
-    except KeyError:
-        raise FormatError(f"the archive has no member {name!r}") from None
-    if expected is not None and info.file_size != expected:
-        raise FormatError(f"{name} holds {info.file_size} bytes, but the header implies {expected}")
-    if limit is not None and info.file_size > limit:
-        raise FormatError(f"{name} is {info.file_size} bytes, more than rough reads ({limit})")
-    if info.flag_bits & 0x1:
-        raise FormatError(f"{name} is encrypted; X3P members are plain")
-    view = memoryview(data)
-    header = bytes(view[info.header_offset : info.header_offset + 30])
-    if len(header) < 30 or header[:4] != b"PK\x03\x04":
-        raise FormatError(f"damaged zip: no local header for {name}")
-    start = info.header_offset + 30 + sum(struct.unpack("<HH", header[26:30]))
-    if info.compress_type == zipfile.ZIP_STORED:
-        content = view[start : start + info.file_size]
-        if len(content) != info.file_size:
-            raise FormatError(f"truncated archive: {name} is cut short")
-    else:
-        content = _unpacked(info, view[start : start + info.compress_size], name)
-    return info, content
-
-
-def _unpacked(info, packed, name):
-    """A compressed member unpacked in chunks, never past the size its entry declares,
-    which must itself be within the caps of rough.io.limits."""
-    limits.Budget(len(packed), name).add(info.file_size)
-    content, filled = bytearray(info.file_size), 0
-    try:
-        unpacker, packed = _unpacker(info, bytes(packed), name)
-        while not unpacker.eof:
-            part = unpacker.decompress(packed, min(limits.CHUNK << 4, info.file_size - filled + 1))
-            packed = getattr(unpacker, "unconsumed_tail", b"")
-            if (not part and getattr(unpacker, "needs_input", not packed)) or filled + len(part) > info.file_size:
-                break
-            content[filled : filled + len(part)] = part
-            filled += len(part)
-    except ZIP_ERRORS as error:
-        raise FormatError(f"{name} cannot be unpacked ({type(error).__name__}: {error})") from None
-    if not unpacker.eof or filled != info.file_size:
-        raise FormatError(f"{name} does not hold the {info.file_size} bytes its zip entry declares")
-    return content
-
-
-def _unpacker(info, packed, name):
-    """The decompressor of a zip member and the bytes to feed it."""
-    if info.compress_type == zipfile.ZIP_DEFLATED:
-        return zlib.decompressobj(-15), packed
-    if info.compress_type == zipfile.ZIP_BZIP2:
-        return bz2.BZ2Decompressor(), packed
-    if info.compress_type == zipfile.ZIP_LZMA and len(packed) > 4:  # zip's LZMA: version, size, properties
-        size = struct.unpack("<H", packed[2:4])[0]
-        properties = lzma._decode_filter_properties(lzma.FILTER_LZMA1, packed[4 : 4 + size])
-        return lzma.LZMADecompressor(lzma.FORMAT_RAW, filters=[properties]), packed[4 + size :]
-    raise FormatError(f"{name} cannot be unpacked (zip compression method {info.compress_type})")
 
 
 def _parse_xml(document):
@@ -515,7 +211,7 @@ def _main_checksum_problem(archive, prefix, root, document, data):
     member = f"{prefix}{name}"
     if member not in archive.namelist():
         return f"the checksum file {name} named by Record4 is missing"
-    stated = bytes(_member(archive, member, data, limit=4096)).split()
+    stated = bytes(ziparchive.member(archive, member, data, limit=4096)).split()
     actual = hashlib.md5(document).hexdigest()
     if not stated or stated[0].decode("ascii", "replace").lower() != actual:
         shown = stated[0][:32].decode("ascii", "replace") if stated else "nothing"
@@ -601,10 +297,10 @@ def _binary_records(archive, prefix, root, data, fields, count, verify):
 
 def _checked_member(archive, prefix, link, data, stated, verify, **sizes):
     """``(bytes, MD5 hex, CRC-32)`` of a binary member, hashed once (or on the way in,
-    by :func:`receive`): its MD5 checked against ``stated``, its zip CRC-32 only when
+    by :func:`rough.io.receiving.receive`): its MD5 checked against ``stated``, its zip CRC-32 only when
     there is no MD5 to check."""
-    info, content = _located(archive, f"{prefix}{link}", data, **sizes)
-    actual, crc = _arrived(content) or _hashes(content)
+    info, content = ziparchive.located(archive, f"{prefix}{link}", data, **sizes)
+    actual, crc = receiving.arrived(content) or receiving.hashes(content)
     if not (verify and stated) and crc != info.CRC:
         raise FormatError(f"{prefix}{link} fails its zip CRC check: the archive is damaged")
     _check(verify, _md5_problem(actual, stated, link))
@@ -773,10 +469,10 @@ def _surface(points, nx, ny, options):
         problem = f"rotated by {_rotation_text(points.rotation)} in its placement; rough keeps grids axis-aligned"
         if options.regrid is None:
             raise FormatError(f"{problem}: give --regrid SPACING to resample it in the placed frame")
-        return _gridded(*points.placed(), options, problem)
+        return rough_io.gridding.grid_points(*points.placed(), options, problem)
     axes = [_regular_axis(points, name, nx, ny) for name in ("CX", "CY")]
     if None in axes:
-        return _gridded(*points.placed(), options, f"an irregular grid of {nx}×{ny} points")
+        return rough_io.gridding.grid_points(*points.placed(), options, f"an irregular grid of {nx}×{ny} points")
     (dx, x0), (dy, y0) = axes
     heights = points.heights().reshape(ny, nx)
     for _ in range(turns):  # (x, y) → (−y, x)
@@ -808,36 +504,6 @@ def _profile(points, nx, options):
     return profile.heights, profile.spacing, profile.origin, notes, profile.history
 
 
-def _gridded(x, y, z, options, what):
-    """Points interpolated linearly (Delaunay triangles, ``scipy.interpolate.griddata``)
-    onto a square grid of ``options.regrid``'s spacing over their extent; NaN outside
-    their convex hull."""
-    if options.regrid is None:
-        raise FormatError(
-            f"{what}: give --regrid SPACING to grid it (rough reads point clouds and irregular grids only gridded)"
-        )
-    spacing, method = options.regrid
-    if len(z) < 3:
-        raise FormatError(f"{what} has {len(z)} valid points; gridding needs at least three")
-    spans = [(float(v.max() - v.min()) / spacing) * (1 + 1e-12) for v in (x, y)]
-    check_size([span + 1 for span in spans[::-1]], "the gridded surface")
-    nx, ny = (int(np.floor(span)) + 1 for span in spans)
-    if min(nx, ny) < 2:
-        raise FormatError(f"a regrid spacing of {spacing:.6g} m leaves fewer than two points across {what}")
-    from scipy.interpolate import griddata
-    from scipy.spatial import QhullError
-
-    gx, gy = x.min() + spacing * np.arange(nx), y.min() + spacing * np.arange(ny)
-    try:
-        heights = griddata((x, y), z, (gx[np.newaxis, :], gy[:, np.newaxis]), method="linear")
-    except (QhullError, ValueError) as error:
-        raise FormatError(f"cannot triangulate {what} ({str(error).strip().splitlines()[0]})") from None
-    if method != "linear":
-        log.info("a map is regridded linearly; band-limited regridding applies to profiles")
-    step = history_entry("regrid", {"spacing": spacing, "method": "linear", "points_read": len(z)})
-    return heights, (spacing, spacing), (float(x.min()), float(y.min())), {}, [step]
-
-
 def _metadata(root):
     record = {
         "date": "Record2/Date",
@@ -857,7 +523,7 @@ def _metadata(root):
 
 def _vendor(archive, prefix, data):
     """rough's own record, which holds the metadata that Record2 was written from."""
-    stored = json.loads(bytes(_member(archive, f"{prefix}{VENDOR_MEMBER}", data, limit=MAX_SIDE_BYTES)))
+    stored = json.loads(bytes(ziparchive.member(archive, f"{prefix}{VENDOR_MEMBER}", data, limit=MAX_SIDE_BYTES)))
     return provenance.restore(stored, units=Units("m", "m"))
 
 
@@ -872,7 +538,7 @@ def _same_bytes(heights, stored):
     return (
         heights.dtype == np.dtype("<f8")
         and heights.flags.c_contiguous
-        and (_address(heights), heights.nbytes) == stored
+        and (receiving.address(heights), heights.nbytes) == stored
     )
 
 
@@ -880,7 +546,8 @@ def _remember_digest(heights, digests):
     """Remember the verified ``(MD5 hex, CRC-32)`` of a read-only height array that
     views the bytes they were computed on, so that writing the same array again need
     not hash it again. The array cannot change: its memory is a read-only view of bytes
-    that nothing else holds (an immutable bytes object, or the buffer of :func:`receive`)."""
+    that nothing else holds (an immutable bytes object, or the buffer of
+    :func:`rough.io.receiving.receive`)."""
     for key in [key for key, (ref, _) in _verified_digests.items() if ref() is None]:
         del _verified_digests[key]
     if not heights.flags.writeable:
@@ -891,117 +558,7 @@ def _digests(heights, payload):
     """``(MD5 hex, CRC-32)`` of the data: those verified when ``heights`` was read, or
     computed now."""
     ref, digests = _verified_digests.get(id(heights), (lambda: None, None))
-    return digests if ref() is heights else _hashes(payload)
-
-
-def _hashes(content):
-    """``(MD5 hex, CRC-32)`` of ``content`` in one pass: the MD5 in a worker thread
-    (hashlib and zlib release the GIL on large buffers) while this one takes the CRC."""
-    md5 = hashlib.md5()
-    if len(content) < HASH_STEP:
-        md5.update(content)
-        return md5.hexdigest(), zlib.crc32(content)
-    worker = threading.Thread(target=md5.update, args=(content,), daemon=True)
-    worker.start()
-    try:
-        crc = zlib.crc32(content)
-    finally:
-        worker.join()
-    return md5.hexdigest(), crc
-
-
-LOCAL_HEADER = struct.Struct("<4s5H3L2H")  # signature, version, flags, method, time, date, CRC, sizes, name, extra
-CENTRAL_HEADER = struct.Struct("<4s4B4H3L5H2L")
-END_RECORD = struct.Struct("<4s4H2LH")
-ZIP64_END_RECORD = struct.Struct("<4sQ2H2L4Q")
-ZIP64_LOCATOR = struct.Struct("<4sLQL")
-ZIP64_LIMIT = 0xFFFFFFFF  # sizes and offsets from here on go in ZIP64 fields
-ZIP64_MARK = 0xFFFFFFFF  # what a header's field holds when a ZIP64 field holds the value
-UNIX = 3  # the "made by" system, for the Unix permissions in the external attributes
-
-
-class _ZipWriter:
-    """A zip archive of stored members written front to back to any binary stream
-    (pipes included: nothing is sought back). Each local header holds its member's
-    CRC-32 and sizes, so no data descriptor follows the data, and member data are
-    written as given, without a copy."""
-
-    def __init__(self, stream):
-        self.stream, self.offset, self.entries = stream, 0, []
-        year, month, day, hour, minute, second = _zip_time()
-        self.time = hour << 11 | minute << 5 | second // 2
-        self.date = (year - 1980) << 9 | month << 5 | day
-
-    def add(self, name, content, crc=None, align=None):
-        """One member; ``crc`` is the CRC-32 of ``content`` if known; ``align`` pads the
-        local header's extra field so that the data start at a multiple of it."""
-        name = name.encode("ascii")
-        size = len(content)
-        crc = zlib.crc32(content) if crc is None else crc
-        large = size >= ZIP64_LIMIT
-        extra = struct.pack("<2H2Q", 1, 16, size, size) if large else b""
-        padding = b""
-        if align:
-            gap = -(self.offset + LOCAL_HEADER.size + len(name) + len(extra) + 6) % align
-            padding = struct.pack("<3H", 0xD935, 2 + gap, align) + bytes(gap)
-        extra += padding
-        fields = self._fields(name, extra, crc, size)
-        header = LOCAL_HEADER.pack(b"PK\x03\x04", 45 if large else 20, 0, *fields)
-        self.entries.append((name, crc, size, self.offset, padding))  # the central directory repeats the padding
-        self._put(header + name + extra)
-        self._put(content)
-
-    def close(self):
-        """The central directory and its end records."""
-        start, records = self.offset, []
-        for name, crc, size, offset, padding in self.entries:
-            wide = [size, size] if size >= ZIP64_LIMIT else []
-            wide += [offset] if offset >= ZIP64_LIMIT else []
-            extra = (struct.pack(f"<2H{len(wide)}Q", 1, 8 * len(wide), *wide) if wide else b"") + padding
-            version = 45 if wide else 20
-            fields = self._fields(name, extra, crc, size)
-            place = ZIP64_MARK if offset >= ZIP64_LIMIT else offset
-            attributes = (0, 0, 0, 0o644 << 16, place)  # comment length, disk, internal and external attributes, offset
-            records.append(CENTRAL_HEADER.pack(b"PK\x01\x02", version, UNIX, version, 0, 0, *fields, *attributes))
-            records.append(name + extra)
-        directory = b"".join(records)
-        count, end = len(self.entries), start + len(directory)
-        tail = b""
-        if count >= 0xFFFF or len(directory) >= ZIP64_LIMIT or start >= ZIP64_LIMIT:
-            tail = ZIP64_END_RECORD.pack(
-                b"PK\x06\x06", ZIP64_END_RECORD.size - 12, 45, 45, 0, 0, count, count, len(directory), start
-            ) + ZIP64_LOCATOR.pack(b"PK\x06\x07", 0, end, 1)
-        if tail:
-            count, size, start = 0xFFFF, ZIP64_MARK, ZIP64_MARK
-        else:
-            size = len(directory)
-        tail += END_RECORD.pack(b"PK\x05\x06", 0, 0, count, count, size, start, 0)
-        self._put(directory + tail)
-
-    def _fields(self, name, extra, crc, size):
-        """Method, time, date, CRC-32, sizes and name and extra lengths, as both headers hold them."""
-        stated = ZIP64_MARK if size >= ZIP64_LIMIT else size
-        return zipfile.ZIP_STORED, self.time, self.date, crc, stated, stated, len(name), len(extra)
-
-    def _put(self, content):
-        view = memoryview(content)
-        while len(view):
-            written = self.stream.write(view)
-            if written is None or written >= len(view):
-                break
-            view = view[written:]  # a raw stream may take part of it
-        self.offset += len(content)
-
-
-def _zip_time():
-    """The ZIP entries' time: ZIP cannot hold one before 1980, so earlier ones (as
-    SOURCE_DATE_EPOCH=0 asks for) are stored as 1980-01-01 00:00:00, and none after
-    2107."""
-    stamp = timestamp()
-    moment = tuple(
-        int(part) for part in (stamp[0:4], stamp[5:7], stamp[8:10], stamp[11:13], stamp[14:16], stamp[17:19])
-    )
-    return min(max(moment, (1980, 1, 1, 0, 0, 0)), (2107, 12, 31, 23, 59, 59))
+    return digests if ref() is heights else receiving.hashes(payload)
 
 
 def _main_xml(surface, data_md5, mask_md5):

@@ -22,6 +22,7 @@ import zlib
 import numpy as np
 
 from ..errors import FormatError, InputError
+from ..extras import require
 from ..surface import Units
 from ..units import metres_per
 from . import limits, regrid
@@ -35,7 +36,7 @@ FORMAT = Format(
     magic=(b"PK\x03\x04",),
     probe=lambda head: any(name == "[Content_Types].xml" or name.startswith("xl/") for name in zip_names(head)),
     carries=("spacing", "units", "metadata", "time"),
-    library="openpyxl",
+    read_library="openpyxl",
 )
 
 RESULT = re.compile(r"^\s*(\S+)\s+([+-]?(?:\d+\.?\d*|\.\d+))\s*(\S*)\s*$")
@@ -45,8 +46,6 @@ MAX_ROWS = 1 << 22
 
 
 def read(data, options):
-    from ..extras import require
-
     openpyxl = require("openpyxl")
     data = bytes(data)
     _check_archive(data)

@@ -38,7 +38,7 @@ FORMAT = Format(
     magic=(b"KPK0", b"KPK1"),
     probe=lambda head: head[8:10] == b"BM",
     carries=("spacing", "units", "metadata", "time", "mask"),
-    library="zstandard",
+    read_library="zstandard",
 )
 
 HEIGHTS = "4cdb0c75-5706-48cc-a9a1-adf395d609ae"

@@ -24,10 +24,8 @@ import dataclasses
 import numpy as np
 
 from ..errors import InputError
+from .choices import MODES, POLARITIES
 from .filters import mean_line
-
-MODES = ("A", "B")
-POLARITIES = ("peaks", "pits", "both")
 
 
 @dataclasses.dataclass(frozen=True)

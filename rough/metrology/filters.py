@@ -22,13 +22,14 @@ import dataclasses
 import math
 
 import numpy as np
+from scipy import fft
 
 from ..errors import InputError
 from ..units import format_length
-from .parameters import FFT_BLOCK
+from .choices import ENDS
 
+FFT_BLOCK = 1 << 18  # points per block of 1-D transforms: few calls, a few MB of scratch
 ALPHA = math.sqrt(math.log(2.0) / math.pi)
-ENDS = ("trim", "correct")
 
 
 def gaussian_kernel(spacing, cutoff):
@@ -69,8 +70,6 @@ def convolved(values, kernel, axis=-1):
     >>> (convolved(np.array([0.0, 0.0, 3.0, 0.0, 0.0]), np.array([0.25, 0.5, 0.25])).round(12) + 0.0).tolist()
     [0.0, 0.75, 1.5, 0.75, 0.0]
     """
-    from scipy import fft
-
     lines = np.ascontiguousarray(np.moveaxis(values, axis, -1))
     n, width = lines.shape[-1], kernel.size
     size = fft.next_fast_len(max(8 * width, 256), real=True)

@@ -56,9 +56,11 @@ import functools
 import math
 
 import numpy as np
+from scipy.special import ndtr, ndtri
 
 from ..errors import InputError
-from .parameters import BLOCK, ROUNDING, combined, map_profiles, valid_values
+from .heights import BLOCK, ROUNDING, valid_values
+from .profile import combined, map_profiles
 
 CENTRAL_REGION = 40.0  # % of material ratio, ISO 13565-2 and ISO 25178-2
 PROBABILITY_RANGE = 3.0  # standard deviations either side of the mean, ISO 13565-3
@@ -330,8 +332,6 @@ class MaterialRatioCurve:
         ProbabilityFit
             NaN throughout when fewer than 40 points lie within ±3 standard deviations.
         """
-        from scipy.special import ndtri
-
         n = self.heights.size
         deviates = np.arange(n, dtype=np.float64)
         deviates += 0.5
@@ -372,8 +372,6 @@ def _two_lines(q, h):
     squares over the breaks ``b`` at the points' deviates (q ascending): every break
     on a grid of at most 1024, then every break between the best one's neighbours.
     The moments' running sums are kept only at those breaks (one moment at a time)."""
-    from scipy.special import ndtr
-
     n = q.size
     least = max(2, int(LEAST_REGION * n))
     stride = max(1, (n - 2 * least) // 1024)

@@ -47,7 +47,7 @@ def rq_versus_length(surface):
     -----
     For a self-affine profile σ ∝ L^(2-D) (docs/math.rst §4.6). Removing each
     window's mean biases H low over short windows, so D comes out high: treat the
-    result as a cross-check of :func:`rough.fractal.fit.fit_fractal`, not a
+    result as a cross-check of :func:`rough.fractal.fit_fractal`, not a
     substitute for it.
 
     Examples

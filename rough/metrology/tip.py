@@ -45,11 +45,15 @@ Beyond the ends there is no surface: a tip over an end rests on the points insid
 import logging
 import math
 import os
+import threading
+from concurrent.futures import FIRST_EXCEPTION, ThreadPoolExecutor, wait
 
 import numpy as np
 
 from ..compiled import compiled
 from ..errors import InputError
+from ..progress import progress
+from ..units import format_length
 
 log = logging.getLogger("rough")
 
@@ -257,11 +261,6 @@ def _max_plus(image, radius, spacing, label="tip"):
     loop releases the GIL); the main thread waits with a timeout, so that Ctrl-C stops
     the workers after their current chunk and cancels the rest. A point's result does
     not depend on how the work is cut."""
-    import threading
-    from concurrent.futures import FIRST_EXCEPTION, ThreadPoolExecutor, wait
-
-    from ..progress import progress
-
     quadrant = _quadrant(radius, spacing, image.shape)
     widths = np.isfinite(quadrant).sum(axis=1) - 1  # row k of the tip spans the offsets -w … w along x
     swept = _swept(widths)
@@ -491,8 +490,6 @@ def _check_cost(heights, radius, spacing, passes=1):
     highest points, and its path depends on where the scan ends (nothing is assumed
     beyond), so minutes of exact work buy little that a resampled scan (the cost falls
     as the third or fourth power of the spacing) does not show in seconds."""
-    from ..units import format_length
-
     reach = _reach(radius, spacing, heights.shape)
     # the rows' widths, as the tip's table has them but for an offset on the rim, whichever the rounding
     rows = np.arange(reach[1] + 1) * spacing[1] if len(reach) == 2 else np.zeros(1)

@@ -1,29 +1,73 @@
-"""The render device interface, and the one place that opens a device by its name.
+"""The render device interface, and the registry of backends that opens a device by
+its name.
 
 A device is anything the servo loop can read a position from and write a force to:
 :class:`~rough.render.hand.SimulatedHand` (``sim``), a HID PID joystick through
 hidraw (``hid``, :mod:`rough.render.hid`) and a Linux force-feedback device through
-evdev (``evdev``, :mod:`rough.render.evdev`). Each backend is one module with an
-``open_device(argument, workspace, max_force, **options)`` function and a line in
-:data:`BACKENDS`; nothing else in rough names a backend.
+evdev (``evdev``, :mod:`rough.render.evdev`). Each backend is one module that declares
+its facts once, ``BACKEND = Backend(...)``, and opens a device with
+``open_device(argument, workspace, max_force, **options)``. The built-in modules are
+:data:`BUILT_IN`; a plugin package adds one through the entry-point group
+``rough.devices`` (:mod:`rough.plugins`). Every list of backends (help texts, error
+messages, tests) comes from :func:`backends`.
 
 A physical device reports its stick in its own units; the :class:`Workspace` says
 where the stick's travel lies on the surface (metres) and which axes are reversed.
 """
 
 import dataclasses
+import functools
 import importlib
+import logging
 from typing import Protocol, runtime_checkable
 
 from ..errors import RoughError
+from ..plugins import entry_points
 
-# name -> (module, what it is, the form of the argument after "name:")
-BACKENDS = {
-    "sim": ("rough.render.hand", "a simulated hand", None),
-    "hid": ("rough.render.hid", "a HID PID joystick through hidraw", "VID:PID"),
-    "evdev": ("rough.render.evdev", "a Linux force-feedback device through evdev", "PATH"),
-}
+#: The modules of the built-in backends, in the order messages name them.
+BUILT_IN = ("rough.render.hand", "rough.render.hid", "rough.render.evdev")
+GROUP = "rough.devices"
 DEVICE_DAMPING = 0.45  # N·s/m, assumed: it puts the bound 2b/T at 0.9 N/mm at 1 kHz (docs/math.rst §5.7)
+log = logging.getLogger("rough")
+
+
+@dataclasses.dataclass(frozen=True)
+class Backend:
+    """What a render backend is, declared once in its module as ``BACKEND``.
+
+    Attributes
+    ----------
+    name : str
+        Its name in ``--device NAME[:ARGUMENT]``.
+    title : str
+        What it opens, for help texts, e.g. ``"a simulated hand"``.
+    argument : str or None
+        The form of what may follow ``NAME:``, e.g. ``"VID:PID"``; None when it takes
+        nothing.
+    requires : tuple of str
+        The optional modules it needs (:func:`rough.extras.require` names the extra
+        that installs each).
+    simulated : bool
+        The simulated hand: it strokes by itself, so ``render`` runs it at each
+        ``--speed`` (:func:`rough.render.simulate`) rather than until Ctrl-C.
+
+    Examples
+    --------
+    >>> from rough.render.device import Backend
+    >>> Backend("hid", "a HID PID joystick", argument="VID:PID").form
+    'hid[:VID:PID]'
+    """
+
+    name: str
+    title: str
+    argument: str = None
+    requires: tuple = ()
+    simulated: bool = False
+
+    @property
+    def form(self):
+        """``NAME[:ARGUMENT]``, as help texts write it."""
+        return f"{self.name}[:{self.argument}]" if self.argument else self.name
 
 
 class DeviceError(RoughError):
@@ -176,6 +220,65 @@ class HeldOpen:
         self.device.zero()
 
 
+@functools.cache
+def modules():
+    """``{name: module}`` of every backend: the built-in ones (:data:`BUILT_IN`), then
+    the plugins of the entry-point group ``rough.devices`` whose names are not taken.
+    A plugin that fails to load, or lacks ``BACKEND`` or ``open_device``, is left out
+    with a one-line warning."""
+    found = {}
+    for path in BUILT_IN:
+        module = importlib.import_module(path)
+        found[module.BACKEND.name] = module
+    for name, value in entry_points(GROUP).items():
+        if name not in found:
+            module = _plugin(name, value)
+            if module is not None:
+                found[name] = module
+    return found
+
+
+def _plugin(name, value):
+    try:
+        module = importlib.import_module(value)
+        if not (isinstance(module.BACKEND, Backend) and callable(module.open_device)):
+            raise TypeError("BACKEND must be a rough.render.device.Backend and open_device a function")
+    except Exception as error:  # a broken plugin must not stop rough
+        log.warning(f"the device plugin {name!r} ({value}) is left out: {type(error).__name__}: {error}")
+        return None
+    return module
+
+
+def backends():
+    """``{name: Backend}`` of every backend, built-in first (see :func:`modules`).
+
+    Examples
+    --------
+    >>> from rough.render.device import backends
+    >>> list(backends())[:3]
+    ['sim', 'hid', 'evdev']
+    """
+    return {name: module.BACKEND for name, module in modules().items()}
+
+
+def forms():
+    """The device names ``--device`` takes, for help texts.
+
+    Examples
+    --------
+    >>> from rough.render.device import forms
+    >>> forms()  # with no plugin installed
+    'sim, hid[:VID:PID] or evdev[:PATH]'
+    """
+    *others, last = [backend.form for backend in backends().values()]
+    return f"{', '.join(others)} or {last}" if others else last
+
+
+def descriptions():
+    """What each backend opens, for help texts: ``"sim: a simulated hand; hid: …"``."""
+    return "; ".join(f"{name}: {backend.title}" for name, backend in backends().items())
+
+
 def parse_device(spec):
     """``(backend, argument)`` from a device name such as ``sim``, ``hid:1209:0001`` or
     ``evdev:/dev/input/event5`` (argument None when absent).
@@ -183,7 +286,7 @@ def parse_device(spec):
     Raises
     ------
     rough.RoughError
-        A ``DeviceError`` for a name that is not a backend.
+        A ``DeviceError`` for a name that is not a backend, naming them all.
 
     Examples
     --------
@@ -192,15 +295,16 @@ def parse_device(spec):
     (('hid', '1209:0001'), ('evdev', None))
     """
     name, _, argument = spec.partition(":")
-    if name not in BACKENDS or (argument and BACKENDS[name][2] is None):
-        forms = ", ".join(f"{n} or {n}:{a}" if a else n for n, (_, _, a) in BACKENDS.items())
-        raise DeviceError(f"--device {spec!r}: use {forms}")
+    known = backends()
+    if name not in known or (argument and known[name].argument is None):
+        choices = ", ".join(f"{n} or {n}:{backend.argument}" if backend.argument else n for n, backend in known.items())
+        raise DeviceError(f"--device {spec!r}: use {choices}")
     return name, argument or None
 
 
 def is_simulated(spec):
-    """Whether the device name ``spec`` is a simulated one."""
-    return parse_device(spec)[0] == "sim"
+    """Whether the device name ``spec`` is the simulated hand (:attr:`Backend.simulated`)."""
+    return backends()[parse_device(spec)[0]].simulated
 
 
 def open_device(spec, workspace=None, max_force=None, **options):
@@ -209,7 +313,8 @@ def open_device(spec, workspace=None, max_force=None, **options):
     Parameters
     ----------
     spec : str
-        ``sim``, ``hid[:VID:PID]`` or ``evdev[:PATH]`` (see :data:`BACKENDS`).
+        ``NAME[:ARGUMENT]``, one of :func:`forms`: ``sim``, ``hid[:VID:PID]`` or
+        ``evdev[:PATH]``, or a plugin's.
     workspace : Workspace, optional
         Where the stick's travel lies on the surface (physical devices).
     max_force : float, optional
@@ -235,5 +340,4 @@ def open_device(spec, workspace=None, max_force=None, **options):
     (True, 'sim', True)
     """
     name, argument = parse_device(spec)
-    backend = importlib.import_module(BACKENDS[name][0])
-    return backend.open_device(argument, workspace, max_force, **options)
+    return modules()[name].open_device(argument, workspace, max_force, **options)

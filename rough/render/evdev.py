@@ -39,8 +39,15 @@ import os
 import struct
 import threading
 
-from .device import Capabilities, DeviceError, StreamedForce
+from .. import extras
+from .device import Backend, Capabilities, DeviceError, StreamedForce
 
+BACKEND = Backend(
+    name="evdev",
+    title="a Linux force-feedback device through evdev",
+    argument="PATH",
+    requires=("evdev",),
+)
 FULL_LEVEL = 0x7FFF  # the s16 level of the device's full force
 FULL_GAIN = 0xFFFF
 X_DIRECTION = 0x4000  # the force comes from the left: a positive level pushes towards +ABS_X
@@ -144,9 +151,7 @@ def constant_effect(direction, level, effect_id=-1):
     >>> effect.ff_replay.length, effect.ff_replay.delay, effect.ff_trigger.button
     (0, 0, 0)
     """
-    from ..extras import require
-
-    ff, ecodes = require("evdev.ff"), require("evdev.ecodes")
+    ff, ecodes = extras.require("evdev.ff"), extras.require("evdev.ecodes")
     constant = ff.Constant(level, ff.Envelope(0, 0, 0, 0))
     return ff.Effect(
         ecodes.FF_CONSTANT,
@@ -179,9 +184,7 @@ class EvdevDevice(StreamedForce):
     velocity = (0.0, 0.0)
 
     def __init__(self, device, workspace, max_force, label=None):
-        from ..extras import require
-
-        self.ecodes = require("evdev.ecodes")
+        self.ecodes = extras.require("evdev.ecodes")
         self.device, self.workspace, self.max_force = device, workspace, float(max_force)
         self.label = label or describe(device)
         self.x_sign, self.y_sign = workspace.signs
@@ -375,9 +378,7 @@ def _listing(codes):
 
 
 def _ff_name(code):
-    from ..extras import require
-
-    names = require("evdev.ecodes").FF.get(code, f"FF_{code:#x}")
+    names = extras.require("evdev.ecodes").FF.get(code, f"FF_{code:#x}")
     names = [names] if isinstance(names, str) else [n for n in names if not n.endswith(("_MIN", "_MAX", "_EFFECTS"))]
     return names[0]
 
@@ -393,11 +394,9 @@ def describe(device):
 def _open(path):
     """An ``InputDevice`` opened for reading and writing, or the OSError why not (a
     node python-evdev could open read-only only is a ``PermissionError``)."""
-    import fcntl
+    import fcntl  # optional: haptics (Linux only, as evdev is)
 
-    from ..extras import require
-
-    device = require("evdev").InputDevice(path)
+    device = extras.require("evdev").InputDevice(path)
     if fcntl.fcntl(device.fd, fcntl.F_GETFL) & os.O_ACCMODE != os.O_RDWR:
         device.close()
         raise PermissionError(errno.EACCES, "no permission to write to it", path)
@@ -426,14 +425,12 @@ def _sysfs_look(node, sysfs):
 
 def _open_look(path):
     """``(name, force-feedback codes, problem)`` of the event node ``path``, opening it."""
-    from ..extras import require
-
     try:
         device = _open(path)
     except OSError as error:
         return None, set(), _reason(error)
     try:
-        return device.name, set(device.capabilities(absinfo=False).get(require("evdev.ecodes").EV_FF, ())), None
+        return device.name, set(device.capabilities(absinfo=False).get(extras.require("evdev.ecodes").EV_FF, ())), None
     except OSError as error:
         return device.name, set(), _reason(error)
     finally:

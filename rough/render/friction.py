@@ -17,6 +17,7 @@ Specs on the command line, ``MODEL:key=value,...`` with units:
 import math
 
 from ..errors import InputError
+from ..units import parse_quantity
 
 
 class CoulombViscous:
@@ -161,8 +162,6 @@ def parse_friction(spec):
     ...     print(error)
     '0.3' is not a force (write a number with one of the units N, mN, kN)
     """
-    from ..units import parse_quantity
-
     if spec is None or spec.strip().lower() in ("", "none", "off"):
         return None
     name, _, arguments = spec.partition(":")

@@ -18,8 +18,9 @@ it as a hand does.
 import math
 
 from .contact import zero_order_hold
-from .device import Capabilities
+from .device import Backend, Capabilities
 
+BACKEND = Backend(name="sim", title="a simulated hand", simulated=True)
 HAND_MASS = 0.15  # kg
 HAND_DAMPING = 2.0  # N·s/m
 PRESS = 1.0  # N

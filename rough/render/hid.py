@@ -25,8 +25,10 @@ kernel, with ``--device evdev`` (:mod:`rough.render.evdev`).
 import dataclasses
 import os
 import threading
+import time
 
-from .device import Capabilities, StreamedForce, Workspace
+from .. import extras
+from .device import Backend, Capabilities, StreamedForce, Workspace
 from .pid import (
     CONSTANT_FORCE,
     DEVICE_GAIN,
@@ -54,6 +56,12 @@ from .pid import (
     Y,
 )
 
+BACKEND = Backend(
+    name="hid",
+    title="a HID PID joystick through hidraw",
+    argument="VID:PID",
+    requires=("hidraw", "hidtools"),
+)
 PID_PAGE_ITEM = (b"\x05\x0f", b"\x06\x0f\x00")  # Usage Page (PID), short and long forms
 
 
@@ -187,8 +195,6 @@ class Joystick(StreamedForce):
         return values
 
     def _read_until_position(self):
-        import time
-
         deadline = time.monotonic() + 1.0
         while time.monotonic() < deadline:
             report = self._io(self.handle.read, self.pid.joystick.size + 1, 50)
@@ -318,9 +324,7 @@ def find_joystick(spec="hid", sysfs="/sys"):
     ...     print(error)
     --device 'hid:zz': write hid or hid:VID:PID with hexadecimal IDs, e.g. hid:1209:0001
     """
-    from ..extras import require
-
-    hidraw = require("hidraw")
+    hidraw = extras.require("hidraw")
 
     wanted = None
     if spec != "hid":

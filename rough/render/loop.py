@@ -255,7 +255,7 @@ def run(device, tracks, model, friction=None, settings=None, until=None):
     model : QuasiStatic, DynamicStylus or GradientField
         The contact model (on a map, the gradient field); it starts afresh.
     friction : object, optional
-        A friction model from :func:`parse_friction` (it starts afresh); default none.
+        A friction model from :func:`~rough.render.parse_friction` (it starts afresh); default none.
     settings : Settings, optional
         Default ``Settings()`` (real time, 1 kHz, until stopped).
     until : callable, optional

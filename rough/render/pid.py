@@ -17,6 +17,7 @@ pushes the stick toward its axis's logical maximum.
 
 import dataclasses
 
+from .. import extras
 from ..errors import RoughError
 
 PAGE = 0xF0000
@@ -118,9 +119,7 @@ class PidDescriptor:
     """The reports a constant-force joystick offers, from its report descriptor bytes."""
 
     def __init__(self, descriptor):
-        from ..extras import require
-
-        descriptors = require("hidtools.hid")
+        descriptors = extras.require("hidtools.hid")
 
         try:
             parsed = descriptors.ReportDescriptor.from_bytes(list(descriptor))

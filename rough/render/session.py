@@ -3,11 +3,12 @@ more speeds, or a physical device until Ctrl-C; and their summary for people and
 programs."""
 
 from ..units import format_unit
-from . import forces, simulate
 from .contact import DynamicStylus, GradientField, QuasiStatic
 from .device import Workspace, open_device, parse_device
+from .force_statistics import forces
 from .hand import PRESS
 from .loop import check_ticks, planned_ticks, run
+from .simulation import simulate
 from .stability import VirtualCoupling
 from .track import MapTrack
 

@@ -1,7 +1,7 @@
 """The profile that the stylus rides, prepared for the servo loop.
 
 Heights, slopes and curvatures are computed once, at the nodes of the profile as it is
-rendered (its own spacing: resample first, e.g. ``rough resample --spacing 0.1545mm``,
+rendered (its own spacing: resample first, e.g. ``rough resample --step 0.1545mm``,
 to render at another resolution). Slopes are central differences and curvatures
 second differences on that grid (one-sided at the ends), because the slope RMS of a
 fractal profile grows as Δx^-(D-1): the lateral force depends on the resolution, and

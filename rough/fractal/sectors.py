@@ -25,20 +25,17 @@ import logging
 import math
 
 import numpy as np
+from scipy import fft
+from scipy.special import chdtrc  # χ²'s survival function, without importing scipy.stats
 
 from ..errors import InputError
-from .fit import (
-    MAP_RANGE,
-    Options,
-    band_outcome,
-    below_cutoff,
-    map_band,
-    refuse_flat,
-    ring_fit,
-    sampling_of,
-    tip_cutoff,
-)
+from ..metrology import detrend
+from ..metrology.spatial import autocorrelation_lengths, texture_direction
+from ..progress import progress
+from .fit import below_cutoff, tip_cutoff
 from .psd import sector_spectra, windowed_map
+from .scaling import ring_bins
+from .whittle import MAP_RANGE, Options, band_outcome, map_band, refuse_flat, ring_fit, sampling_of
 
 log = logging.getLogger("rough")
 
@@ -109,7 +106,7 @@ class Rose:
         ISO 25178-2 texture direction of the levelled map, degrees.
     band : tuple of float
         ``(fmin, fmax)``, the frequencies fitted, 1/m: the scaling range of the whole
-        map (see :func:`~rough.fractal.fit.fit_fractal`) unless ``band`` was given.
+        map (see :func:`~rough.fractal.fit_fractal`) unless ``band`` was given.
     verdict : str
         The whole map's verdict over that band: ``power law``, ``at bound`` or ``no
         power-law range`` (then the sectors are fitted over the default band).
@@ -122,7 +119,7 @@ class Rose:
     width : float
         The width of each sector, degrees.
     sampling : str
-        ``"point"`` or ``"band-limited"``, as for :func:`~rough.fractal.fit.fit_fractal`.
+        ``"point"`` or ``"band-limited"``, as for :func:`~rough.fractal.fit_fractal`.
     reliability_cutoff : float or None
         With a tip radius: the wavelength below which the tip cannot follow the
         surface, metres (the band stops there); None otherwise.
@@ -133,13 +130,13 @@ class Rose:
     ``sectors``, one dict per sector (``angle`` and the fields below it), with
     ``sectors_at_bound`` counting those at a bound, ``band`` as a list, and ``kind``
     ``"sectors"`` (fits of the 2-D spectrum's sectors, not of 1-D profiles: see
-    :func:`rough.fractal.profiles.profile_rose`).
+    :func:`rough.fractal.profile_rose`).
 
     Examples
     --------
     >>> import rough
-    >>> from rough.fractal.resample import fill_invalid
-    >>> from rough.fractal.rose import rose
+    >>> from rough.fractal.filling import fill_invalid
+    >>> from rough.fractal.sectors import rose
     >>> result = rose(fill_invalid(rough.read(rough.sample("rock-map.x3p"))), step=30)
     >>> result.angles
     [0, 30, 60, 90, 120, 150]
@@ -205,13 +202,13 @@ def rose(
 
     The map's form is removed, it is tapered with the periodic Hann window and its
     2-D periodogram is taken once; in each direction sector the ordinates are
-    averaged over rings and fitted as in :func:`~rough.fractal.fit.fit_fractal`.
+    averaged over rings and fitted as in :func:`~rough.fractal.fit_fractal`.
 
     Parameters
     ----------
     surface : Surface
         A gap-free map: fill invalid (NaN) points first (see
-        :func:`~rough.fractal.resample.fill_invalid`).
+        :func:`~rough.fractal.fill_invalid`).
     step : float, default 10.0
         The spacing of the sector centres, degrees; it must divide 180 and be at
         most 90.
@@ -219,7 +216,7 @@ def rose(
         The width of each sector, degrees, in (0, 180]; default ``step``
         (non-overlapping sectors, needed for the isotropy tests).
     band : tuple of (float or None), optional
-        ``(fmin, fmax)`` in 1/m, as for :func:`~rough.fractal.fit.fit_fractal` on a map.
+        ``(fmin, fmax)`` in 1/m, as for :func:`~rough.fractal.fit_fractal` on a map.
     resolution : float, optional
         The η in metres at which C is stated; default the smaller spacing.
     order : int, default 1
@@ -227,12 +224,12 @@ def rose(
     sampling : {"point", "band-limited"}, optional
         Default: read from the surface's history.
     noise, rolloff, level
-        The spectral model and the test, as for :func:`~rough.fractal.fit.fit_fractal`;
+        The spectral model and the test, as for :func:`~rough.fractal.fit_fractal`;
         the band is chosen once on the whole map, and every sector gets its own
         noise floor.
     tip_radius : float, optional
         A tip radius, metres: the band stops at the wavelength below which such a
-        tip cannot follow the map's rows (as for :func:`~rough.fractal.fit.fit_fractal`),
+        tip cannot follow the map's rows (as for :func:`~rough.fractal.fit_fractal`),
         recorded as ``reliability_cutoff``.
 
     Returns
@@ -261,8 +258,8 @@ def rose(
     the smaller C at right angles to it, and rejects isotropy.
 
     >>> import math
-    >>> from rough.fractal.rose import rose
-    >>> from rough.fractal.synth import synthesize_map
+    >>> from rough.fractal.sectors import rose
+    >>> from rough.fractal.synth_map import synthesize_map
     >>> anisotropy = (2.2, 1e-6, 2.5, 3e-6, math.radians(30))
     >>> scan = synthesize_map((256, 256), (10e-6, 10e-6), None, anisotropy=anisotropy, seed=1)
     >>> result = rose(scan, step=15)
@@ -273,9 +270,6 @@ def rose(
     >>> result.isotropy_p_value["amplitude_coefficient"] < 1e-6
     True
     """
-    from ..metrology import detrend
-    from ..metrology.parameters import autocorrelation_lengths, texture_direction
-
     if surface.is_profile:
         raise InputError("a rose needs a map (a direction in the plane); this is a profile")
     if np.isnan(surface.heights).any():
@@ -292,11 +286,6 @@ def rose(
         band = band if cutoff is None else below_cutoff(surface, band, sampling, cutoff)
     frequency_step, low, high = map_band(surface, band, sampling)
     high = min(high, math.hypot(0.5 / surface.spacing[0], 0.5 / surface.spacing[1]))  # no ring lies beyond the corner
-    from scipy import fft
-
-    from ..progress import progress
-    from .scaling import ring_bins
-
     log.info(
         f"{round(180 / step)} sectors {width:g}° wide over a {surface.heights.shape[1]} × "
         f"{surface.heights.shape[0]} map"
@@ -379,8 +368,6 @@ def _enough(rings):
 
 
 def _sector_fit(rings, spacing, resolution, options):
-    from .scaling import ring_bins
-
     _enough(rings)
     return ring_fit(ring_bins(rings, spacing), resolution, options)
 
@@ -412,8 +399,6 @@ def _principal_direction(angles, levels):
 def _flatness(fits, independent):
     """p-values of χ² tests that D(θ) and log C(θ) are constant over the sectors not
     at a bound; None for overlapping sectors (not independent) or fewer than two."""
-    from scipy.special import chdtrc  # χ²'s survival function, without importing scipy.stats
-
     if not independent or len(fits) < 2:
         return {"fractal_dimension": None, "amplitude_coefficient": None}
     result = {}

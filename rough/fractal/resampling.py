@@ -14,17 +14,19 @@ scales rather than continued with synthetic roughness (synthesise for that).
 
 Ends are padded by linear extrapolation of the data (``padtype='line'``). Invalid
 points must be filled first (``fill=True``: linear interpolation along profiles,
-biharmonic inpainting for maps); the points that fall where data were missing are
-set back to NaN in the result.
+biharmonic inpainting for maps, :mod:`rough.fractal.filling`); the points that fall
+where data were missing are set back to NaN in the result.
 """
 
 import fractions
 import math
 
 import numpy as np
+from scipy.signal import resample_poly
 
 from ..errors import InputError
 from ..surface import check_size
+from .filling import filled
 
 MAX_DENOMINATOR = 1000
 
@@ -45,14 +47,14 @@ def resample(surface, spacing, fill=False):
         old to new spacing must be a fraction of integers up to 1000 (to within
         1e-9).
     fill : bool, default False
-        Fill invalid (NaN) points first (see :func:`fill_invalid`); without it a
+        Fill invalid (NaN) points first (see :func:`~rough.fractal.fill_invalid`); without it a
         surface with invalid points is refused.
 
     Returns
     -------
     Surface
         Heights in metres at the new spacing, with a ``resample`` history entry
-        (which :func:`~rough.fractal.fit.fit_fractal` reads to treat the result as
+        (which :func:`~rough.fractal.fit_fractal` reads to treat the result as
         band-limited). With ``fill``, the new points nearest to an old invalid one
         are set back to NaN.
 
@@ -77,7 +79,7 @@ def resample(surface, spacing, fill=False):
 
     >>> import numpy as np
     >>> import rough
-    >>> from rough.fractal.resample import resample
+    >>> from rough.fractal.resampling import resample
     >>> scan = rough.read(rough.sample("rock-profile.tsv"))  # 2048 points at 30.9 µm
     >>> coarse = resample(scan, 0.1545e-3)
     >>> coarse.points, coarse.spacing, coarse.history[-1]["command"]
@@ -98,8 +100,6 @@ def resample(surface, spacing, fill=False):
     >>> coarse.points, int(np.isnan(coarse.heights).sum())
     ((64, 48), 2)
     """
-    from scipy.signal import resample_poly
-
     targets = tuple(np.broadcast_to(np.asarray(spacing, dtype=float), (surface.heights.ndim,)))
     if not all(t > 0 and np.isfinite(t) for t in targets):
         raise InputError(f"the new spacing must be positive, not {spacing}")
@@ -137,61 +137,6 @@ def _ratio(old, new):
             "resample in steps, or synthesise the fine scales"
         )
     return ratio
-
-
-def fill_invalid(surface):
-    """A surface with its invalid (NaN) points filled.
-
-    Linear interpolation along a profile (the ends take the nearest valid value);
-    scikit-image's biharmonic inpainting in a map.
-
-    Parameters
-    ----------
-    surface : Surface
-        A profile or map with at least one valid point.
-
-    Returns
-    -------
-    Surface
-        With no NaN left, recorded as a ``fill`` history entry; the same surface,
-        unchanged, when every point is valid.
-
-    Raises
-    ------
-    rough.InputError
-        When no point is valid.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> import rough
-    >>> from rough.fractal.resample import fill_invalid
-    >>> heights = np.array([0.0, 1.0, np.nan, 3.0, np.nan, np.nan, 6.0]) * 1e-6
-    >>> (fill_invalid(rough.Surface(heights, 10e-6)).heights * 1e6).round(9).tolist()  # µm
-    [0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0]
-    >>> scan = rough.read(rough.sample("rock-map.x3p"))
-    >>> filled = fill_invalid(scan)
-    >>> int(np.isnan(filled.heights).sum()), filled.history[-1]["command"]
-    (0, 'fill')
-    """
-    if not np.isnan(surface.heights).any():
-        return surface
-    return surface.derive("fill", {}, heights=filled(surface))
-
-
-def filled(surface):
-    """The heights with invalid points filled: linear interpolation along a profile,
-    scikit-image's biharmonic inpainting in a map."""
-    heights = surface.heights
-    invalid = np.isnan(heights)
-    if invalid.all():
-        raise InputError("no valid points to fill from")
-    if heights.ndim == 1:
-        index = np.arange(heights.size)
-        return np.interp(index, index[~invalid], heights[~invalid])
-    from skimage.restoration import inpaint_biharmonic
-
-    return inpaint_biharmonic(np.where(invalid, 0.0, heights), invalid)
 
 
 def _nearest_invalid(invalid, old_spacing, new_spacing, shape):

@@ -1,0 +1,22 @@
+# The public names of ``rough.io``, loaded on first use by lazy_loader (see __init__.py).
+from . import atomic as atomic
+from . import gridding as gridding
+from . import limits as limits
+from . import registry as registry
+from .atomic import atomic_output as atomic_output
+from .atomic import names_a_terminal as names_a_terminal
+from .atomic import standard_output as standard_output
+from .reading import GZIP_MAGIC as GZIP_MAGIC
+from .reading import ReadOptions as ReadOptions
+from .reading import gunzip as gunzip
+from .reading import read as read
+from .reading import read_bytes as read_bytes
+from .receiving import widen_pipe as widen_pipe
+from .registry import describe as describe
+from .registry import sniff as sniff
+from .tables import BINARY as BINARY
+from .tables import EXTENSIONS as EXTENSIONS
+from .tables import FORMATS as FORMATS
+from .tables import WRITABLE as WRITABLE
+from .writing import format_for_path as format_for_path
+from .writing import write as write
