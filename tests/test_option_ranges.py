@@ -108,6 +108,7 @@ BASES = {
     ("info",): ["{map}", "--json"],
     ("resample",): ["{map}", "--step", "4um", "-o", "{out}"],
     ("rose",): ["{map}", "--json"],
+    ("map",): ["{map}", "--window", "16px", "--parameters", "Sq,hurst", "--json"],
     ("render",): ["{map}", "--duration", "20ms", "--json"],
     ("synth",): ["--size", "32x32", "--step", "2um", "--dimension", "2.3", "--rq", "1um", "-o", "{out}"],
     ("experiment", "design"): ["{folder}", "--reference", "1.275,0.2781mm", "--subjects", "1", "--seed", "1"],

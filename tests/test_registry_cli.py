@@ -83,7 +83,7 @@ def test_an_old_option_name_still_works_with_one_warning(old, new):
     assert before.returncode == 0 and before.stdout == after.stdout
     assert after.stderr == b""
     (line,) = before.stderr.decode().splitlines()
-    assert f"{old[3]} is deprecated (rough 0.12): use {new[3]}; it goes in 0.13" in line
+    assert f"{old[3]} is deprecated (rough 0.12): use {new[3]}; it goes in 0.14" in line
 
 
 def test_old_and_new_name_together_is_a_usage_error():
@@ -125,7 +125,7 @@ def test_a_bare_length_is_read_in_mm_with_a_warning(bare, named, said):
     quiet = rough("detrend", "-f", "tsv", *named, input=surface, check=True)
     assert warned.returncode == 0 and warned.stdout == quiet.stdout and quiet.stderr == b""
     (line,) = warned.stderr.decode().splitlines()
-    assert said in line and "write the unit (bare numbers are refused from rough 0.13)" in line
+    assert said in line and "write the unit (bare numbers are refused from rough 0.14)" in line
 
 
 def test_a_bare_frequency_is_per_mm_and_a_bare_quantity_in_its_old_unit_with_a_warning():

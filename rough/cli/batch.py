@@ -4,16 +4,28 @@ reported in one line and skipped, and the exit status at the end is the worst se
 Side files (``--plot``, ``--psd``, ``--list``, ``--segments``) then need ``{stem}`` (the
 input's name without directory and extension) or ``{name}`` in their names, and a
 surface output ``-o`` names a directory (``out/``).
+
+With ``--jobs N`` (N > 1) the inputs are worked on by N forked processes
+(:mod:`rough.cli.pool`) and everything is printed by this process in input order, as
+with one: each worker keeps its input's log lines, warnings, report and error line
+and sends them back, so that standard output and standard error read as they would
+one input after another. Side files are written by the workers.
 """
 
+import contextlib
+import dataclasses
+import logging
 import os
 import sys
 
 import click
 
 from .. import errors, io, progress
+from . import pool
 from .main import current_input, failure, say
 from .report import Printer, collected_warnings
+
+log = logging.getLogger("rough")
 
 #: The options that name a file written beside the report (or instead of one), and their flags.
 SIDE_FILES = {
@@ -30,6 +42,7 @@ def run_each(work, names, options):
     ``options``' ``as_json``/``as_tsv``. Returns the exit status."""
     many = len(names) > 1
     check_inputs(names)
+    jobs = options.pop("jobs", 1)
     printer = Printer(options.pop("as_json", False), options.pop("as_tsv", False), many)
     side = {key: options[key] for key in SIDE_FILES if options.get(key)}
     if many:
@@ -38,12 +51,15 @@ def run_each(work, names, options):
             options["output"].check_directory(names)
     elif "output" in options:
         options["output"].check()
+    if many:
+        jobs, note = pool.usable_jobs(jobs, len(names))
+        if note:
+            log.warning(note)
+        if jobs > 1:
+            return _in_parallel(work, names, options, side, printer, jobs)
     status = 0
     for name in _progress(names, many):
-        named = {**options, **{key: stem_name(path, name) for key, path in side.items()}}
-        if "output" in options:
-            named["output"] = options["output"].for_input(name)
-        report, warnings, failed = _one(work, name, named, many)
+        report, warnings, failed = _one(work, name, _named(options, side, name), many)
         status = max(status, failed)
         if report is not None:
             printer.print(report, name, warnings)
@@ -55,14 +71,31 @@ def read_named(name, options):
     return io.read(name, **options)
 
 
+def _named(options, side, name):
+    """The options for input ``name``: its side files and output."""
+    named = {**options, **{key: stem_name(path, name) for key, path in side.items()}}
+    if "output" in options:
+        named["output"] = options["output"].for_input(name)
+    return named
+
+
 def _one(work, name, options, many):
     """(report, warnings, status) of one input; with several, a failure is reported
     and its status returned instead of raised."""
+    report, warnings, status, message = _attempt(work, name, options, many)
+    if message is not None:
+        say(message)
+    return report, warnings, status
+
+
+def _attempt(work, name, options, many):
+    """(report, warnings, status, error message or None) of one input; with several,
+    a failure's message is returned instead of raised."""
     current_input[:] = [printable_name(name)] if many else []
     try:
         with collected_warnings() as warnings:
             report = work(name, **options)
-        return report, warnings, 0
+        return report, warnings, 0, None
     except errors.InputError as error:
         failed = _named_error(error, name)
         if not many:
@@ -76,8 +109,90 @@ def _one(work, name, options, many):
     finally:
         current_input[:] = []
     message, status = failure(failed)
-    say(message)
-    return None, [], status
+    return None, [], status, message
+
+
+@dataclasses.dataclass
+class _Outcome:
+    """What a worker sends back for one input (it pickles)."""
+
+    report: object = None
+    warnings: list = dataclasses.field(default_factory=list)
+    status: int = 0
+    message: str = None  # the error line
+    log: list = dataclasses.field(default_factory=list)  # (level, message) logged meanwhile
+    stop: tuple = None  # a click error that ends the command: (usage?, message, exit status)
+
+
+def _in_parallel(work, names, options, side, printer, jobs):
+    """:func:`run_each`'s loop over ``jobs`` worker processes; the exit status."""
+
+    def task(index):
+        return _in_worker(work, names[index], _named(options, side, names[index]))
+
+    status = 0
+    with (
+        progress.progress(total=len(names), description="files", unit="file") as bar,
+        contextlib.closing(pool.ordered(task, len(names), jobs, lambda: bar.update(1))) as outcomes,
+    ):
+        for name, outcome in zip(names, outcomes):
+            report, warnings, failed = _replay(name, outcome)
+            status = max(status, failed)
+            if report is not None:
+                printer.print(report, name, warnings)
+    return status
+
+
+class _Kept(logging.Handler):
+    """Keeps a worker's log records, to be logged again by the parent in input order."""
+
+    def __init__(self, level):
+        super().__init__(level)
+        self.records = []
+
+    def emit(self, record):
+        self.records.append((record.levelno, record.getMessage()))
+
+
+def _in_worker(work, name, options):
+    """One input in a worker process: an :class:`_Outcome`, nothing printed."""
+    logger = logging.getLogger("rough")
+    if not any(isinstance(handler, _Kept) for handler in logger.handlers):
+        level = min((handler.level for handler in logger.handlers), default=logging.WARNING)
+        logger.handlers[:] = [_Kept(level)]
+        progress.configure(False)
+    kept = next(handler for handler in logger.handlers if isinstance(handler, _Kept))
+    kept.records = []
+    try:
+        report, warnings, status, message = _attempt(work, name, options, True)
+    except click.ClickException as error:
+        stop = (isinstance(error, click.UsageError), error.format_message(), error.exit_code)
+        return _Outcome(log=kept.records, stop=stop)
+    return _Outcome(report, warnings, status, message, kept.records)
+
+
+def _replay(name, outcome):
+    """Print, in this process, what a worker logged for input ``name``; (report,
+    warnings, status) as :func:`_one` returns them."""
+    if isinstance(outcome, (pool.Died, pool.Failed)):
+        say(f"{printable_name(name)}: {outcome.message() if isinstance(outcome, pool.Died) else outcome.message}")
+        return None, [], 1
+    current_input[:] = [printable_name(name)]
+    try:
+        for level, message in outcome.log:
+            log.log(level, message)
+    finally:
+        current_input[:] = []
+    if outcome.stop is not None:
+        usage, message, status = outcome.stop
+        if usage:
+            raise click.UsageError(message)
+        error = click.ClickException(message)
+        error.exit_code = status
+        raise error
+    if outcome.message is not None:
+        say(outcome.message)
+    return outcome.report, outcome.warnings, outcome.status
 
 
 def _named_error(error, name):

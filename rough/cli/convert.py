@@ -3,7 +3,7 @@
 import click
 
 from ..io import registry
-from .options import surface_input, surface_output
+from .options import jobs_option, surface_input, surface_output
 
 
 class WritesCommand(click.Command):
@@ -22,6 +22,7 @@ class WritesCommand(click.Command):
 
 @click.command(cls=WritesCommand, short_help="Convert between the formats rough reads and writes.")
 @surface_input
+@jobs_option
 @surface_output
 def convert(surface, input, output):
     """Read INPUT (default: standard input) in any format rough reads, and write it

@@ -15,6 +15,7 @@ from .options import (
     FloatRange,
     RegistryChoice,
     crop_option,
+    jobs_option,
     plot_option,
     report_format,
     surface_input,
@@ -24,6 +25,7 @@ from .report import Report, on_stdout, shown
 
 @click.command(short_help="ISO parameters (Ra…JRC, Sa…Std), amplitude density, feature detection.")
 @surface_input
+@jobs_option
 @crop_option
 @click.option(
     "--cutoff", type=LENGTH, help="Evaluate the roughness at this Gaussian cut-off λc instead of the data as given."

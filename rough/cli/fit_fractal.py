@@ -11,6 +11,7 @@ from .options import (
     RegistryChoice,
     crop_option,
     gaps_option,
+    jobs_option,
     model_options,
     plot_option,
     report_format,
@@ -21,6 +22,7 @@ from .report import Report, on_stdout, shown
 
 @click.command("fit-fractal", short_help="Fractal dimension D and amplitude coefficient C, with uncertainty.")
 @surface_input
+@jobs_option
 @crop_option
 @click.option(
     "--band",

@@ -3,12 +3,13 @@
 import click
 
 from .. import io, metrology, units
-from .options import report_format, surface_input
+from .options import jobs_option, report_format, surface_input
 from .report import Report
 
 
 @click.command(short_help="Shape, spacing, size, valid points, z range, Rq/Sq and history.")
 @surface_input
+@jobs_option
 @report_format
 def info(surface, input):
     """Describe the surface in INPUT (default: standard input).

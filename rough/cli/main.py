@@ -41,6 +41,7 @@ COMMANDS = {
     "show": "rough.cli.show:show",
     "render": "rough.cli.render:render",
     "experiment": "rough.cli.experiment:experiment",
+    "map": "rough.cli.map:map_command",
 }
 
 log = logging.getLogger("rough")

@@ -10,7 +10,7 @@ output); ``surface_output`` adds ``-o/--output`` and ``-f/--format`` and hands i
 Lengths, frequencies and physical quantities name their unit (``0.1545mm``,
 ``0.2/mm``, ``20mm/s``); zero needs none. rough 0.12 still reads a bare number in the
 option's old default unit (mm, per mm, the quantity's), with a one-line warning
-(:func:`bare_number`); rough 0.13 refuses it.
+(:func:`bare_number`); rough 0.14 refuses it.
 
 Every number an option takes is range-checked here, by its type: it must be finite
 (NaN and infinities refused), positive where the option says so, and of a plausible
@@ -36,7 +36,7 @@ from .batch import check_inputs, read_named, run_each, stem_name
 
 log = logging.getLogger("rough")
 #: The release that refuses what 0.12 still takes with a warning.
-REFUSED_FROM = "0.13"
+REFUSED_FROM = "0.14"
 
 #: The smallest and largest length (metres) an option takes: 1 pm (below an atom's
 #: size) and 10 000 km (a planet's elevation model, a UTM northing); zero where an
@@ -92,7 +92,7 @@ _warned = set()
 
 def renamed(old, new, name, type=None, required=False):
     """A hidden alias ``old`` (a flag, or a tuple of them) of the option ``new``, whose
-    keyword is ``name``: it works until rough 0.13, with a one-line warning. With
+    keyword is ``name``: it works until rough 0.14, with a one-line warning. With
     ``required``, one of the two must be given (put it above ``input_options``, so that
     this is checked before any input is read)."""
     old = (old,) if isinstance(old, str) else old
@@ -628,6 +628,40 @@ class Output:
             return
         with io.atomic_output("-") as stream:
             io.write(surface, stream, format=self.format)
+
+
+class JobsType(click.ParamType):
+    """``--jobs``: a number of processes from 0 to :data:`MOST_JOBS`, or ``auto`` (0):
+    one per core this process may use."""
+
+    name = "N|auto"
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, int):
+            return value
+        text = str(value).strip().lower()
+        if text == "auto":
+            return 0
+        if not text.isdigit() or int(text) > MOST_JOBS:
+            self.fail(f"{value!r}: give a number of processes from 0 to {MOST_JOBS}, or auto", param, ctx)
+        return int(text)
+
+
+#: The most processes ``--jobs`` starts.
+MOST_JOBS = 256
+
+
+def jobs_option(command):
+    """``--jobs N``: with several inputs, N worker processes (0 or ``auto``: the cores);
+    run_each (:mod:`rough.cli.batch`) takes it."""
+    return click.option(
+        "--jobs",
+        type=JobsType(),
+        default=1,
+        show_default=True,
+        help="With several inputs, work on N at once, each in its own process (0 or auto: one per core); "
+        "the output is the same, in input order.",
+    )(command)
 
 
 def report_format(command):

@@ -3,12 +3,13 @@
 import click
 
 from .. import fractal
-from .options import SPACING, input_options, renamed, surface_output
+from .options import SPACING, input_options, jobs_option, renamed, surface_output
 
 
 @click.command(short_help="Resample to a new spacing without aliasing.")
 @renamed("--spacing", "--step", "step", SPACING, required=True)  # outside input_options: checked before reading
 @input_options("--input-spacing")
+@jobs_option
 @click.option("--step", type=SPACING, help="The new spacing (required), e.g. 0.1545mm (or DX,DY for maps).")
 @click.option("--fill", is_flag=True, help="Fill invalid points first (they are NaN again in the result).")
 @surface_output

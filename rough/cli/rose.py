@@ -13,6 +13,7 @@ from .options import (
     RegistryChoice,
     crop_option,
     gaps_option,
+    jobs_option,
     model_options,
     plot_option,
     renamed,
@@ -24,6 +25,7 @@ from .report import Report, on_stdout, shown
 
 @click.command(short_help="D(θ) and C(θ) by direction for maps (the amplitude coefficient rose); Str, Std.")
 @surface_input
+@jobs_option
 @crop_option
 @click.option(
     "--angle-step",

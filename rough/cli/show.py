@@ -5,7 +5,7 @@ import os
 import click
 
 from .. import extras, metrology, plots
-from .options import crop_option, renamed, surface_input
+from .options import crop_option, jobs_option, renamed, surface_input
 from .report import shown
 
 FORMATS = ("png", "svg", "pdf")
@@ -38,6 +38,7 @@ def _format(output, format):
 @click.command(short_help="Draw a profile or map: height colour map (or hill shade) with units, scale bar and NaN.")
 @renamed(("-o", "--output"), "--plot", "plot")  # outside surface_input: it names one figure per input
 @surface_input
+@jobs_option
 @crop_option
 @click.option(
     "--plot",  # a side file (rough.cli.batch.SIDE_FILES): {stem} in its name names one per input

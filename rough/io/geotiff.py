@@ -104,11 +104,23 @@ def read_path(path, options):
 
 def write(surface, stream):
     """``surface`` as a north-up float64 GeoTIFF, written to ``stream`` (which need not seek)."""
-    rasterio = require("rasterio")
     if surface.is_profile:
         raise InputError("GeoTIFF holds elevation maps, not profiles; write the profile as X3P, GSF or TSV")
-    crs, factor = _crs_for_writing(rasterio, surface.metadata.get("crs"))
-    (ny, nx), (dx, dy), (x0, y0) = surface.heights.shape, surface.spacing, surface.origin
+    tags = {TAGS[part]: text for part, text in provenance.record(surface).items()}
+    write_bands(
+        stream, [(None, surface.heights, {})], surface.spacing, surface.origin, surface.metadata.get("crs"), tags=tags
+    )
+
+
+def write_bands(stream, bands, spacing, origin, crs, dtype="float64", tags=None):
+    """Maps on one grid as the bands of a north-up GeoTIFF (deflate, nodata NaN,
+    ``AREA_OR_POINT=Area``) written to ``stream``: ``bands`` is a list of ``(description
+    or None, heights z[y, x] in rough's orientation, band tags)``; ``spacing`` and ``origin``
+    (metres, x first) place the pixel centres; ``crs`` is a ``metadata["crs"]`` text;
+    ``tags`` go into the dataset's metadata."""
+    rasterio = require("rasterio")
+    crs, factor = _crs_for_writing(rasterio, crs)
+    (ny, nx), (dx, dy), (x0, y0) = bands[0][1].shape, spacing, origin
     transform = rasterio.Affine(
         dx / factor, 0.0, (x0 - dx / 2) / factor, 0.0, -dy / factor, (y0 + (ny - 0.5) * dy) / factor
     )
@@ -116,8 +128,8 @@ def write(surface, stream):
         "driver": "GTiff",
         "width": nx,
         "height": ny,
-        "count": 1,
-        "dtype": "float64",
+        "count": len(bands),
+        "dtype": dtype,
         "nodata": math.nan,
         "crs": crs,
         "transform": transform,
@@ -126,10 +138,13 @@ def write(surface, stream):
     }
     with _quiet(rasterio), rasterio.MemoryFile() as memory:
         with memory.open(**profile) as dataset:
-            dataset.write(surface.heights[::-1], 1)
-            dataset.update_tags(
-                AREA_OR_POINT="Area", **{TAGS[part]: text for part, text in provenance.record(surface).items()}
-            )
+            for number, (description, heights, band_tags) in enumerate(bands, start=1):
+                dataset.write(heights[::-1].astype(dtype, copy=False), number)
+                if description is not None:
+                    dataset.set_band_description(number, description)
+                if band_tags:
+                    dataset.update_tags(number, **band_tags)
+            dataset.update_tags(AREA_OR_POINT="Area", **(tags or {}))
         memory.seek(0)
         while chunk := memory.read(limits.CHUNK << 4):
             stream.write(chunk)

@@ -21,6 +21,9 @@ from .form import remove_form as remove_form
 from .heights import amplitude_density as amplitude_density
 from .levelling import KEEP as KEEP
 from .levelling import detrend as detrend
+from .mapping import MAP_PARAMETERS as MAP_PARAMETERS
+from .mapping import RoughnessMap as RoughnessMap
+from .mapping import roughness_map as roughness_map
 from .material_ratio import AREAL_FUNCTIONAL as AREAL_FUNCTIONAL
 from .material_ratio import PROFILE_FUNCTIONAL as PROFILE_FUNCTIONAL
 from .material_ratio import Core as Core
