@@ -1,6 +1,6 @@
 """Benchmark of the foundation's input and output: the X3P pipe stage and each format.
 
-Run:  .venv/bin/python bench/bench_io.py [--size 4096] [--repeat 5]
+Run:  .venv/bin/python bench/bench_io.py [--size 4096] [--repeat 5] [--surfalize PYTHON [--x3p-only]]
 
 Every figure comes from ``bench/timing.py``'s paired harness: the subject and its
 baseline run back to back, alternately first, ``--repeat`` times, and the line gives
@@ -14,7 +14,15 @@ and the peak memory (× the map's float64 bytes):
     text of the whole map is past what rough parses;
   - a window of a GeoTIFF against the whole file (``--crop`` reads only the window);
   - each instrument file of ``../shared/data`` (when present) against
-    ``numpy.fromfile`` of as many bytes.
+    ``numpy.fromfile`` of as many bytes;
+  - with ``--surfalize PYTHON`` (a Python with surfalize installed, e.g. a separate
+    venv): reading a 1024² and a 2048² X3P file with ``rough.io.read``, which checks
+    the data's MD5, against surfalize's ``Surface.load``, which checks none, each
+    in its own process (surfalize's is started once and asked to read on each turn,
+    so neither start-up is timed), the data member stored (as rough writes it) and
+    deflated (as MountainsMap writes it), at least 15 paired runs; and the MD5 of the
+    data alone against the same surfalize read (the floor of any reader that checks
+    it). ``--x3p-only`` runs only these.
 
 ``rough convert`` runs as ``python -m rough`` with this interpreter and environment,
 so ``PYTHONPATH=. .venv/bin/python bench/bench_io.py`` measures the checkout and
@@ -27,13 +35,16 @@ not see, such as the buffer a stream is read into.
 """
 
 import argparse
+import hashlib
 import importlib.util
 import os
 import pathlib
 import shlex
+import subprocess
 import sys
 import tempfile
 import time
+import zipfile
 
 import numpy as np
 from timing import Child, command, compare
@@ -167,11 +178,91 @@ def instrument_files(repeat):
         )
 
 
+X3P_SIDES = (1024, 2048)
+X3P_REPEAT = 15  # at least this many paired runs: a read takes milliseconds on a shared machine
+PEER_READER = """
+import sys, time
+from surfalize import Surface
+for line in sys.stdin:
+    wall, cpu = time.perf_counter(), time.process_time()
+    Surface.load(line.strip())
+    print(time.perf_counter() - wall, time.process_time() - cpu, flush=True)
+"""
+
+
+class PeerReader:
+    """surfalize reading files in its own interpreter, timed there: each call asks it
+    to read ``path`` once and returns its :class:`timing.Child` figures."""
+
+    def __init__(self, python):
+        self.process = subprocess.Popen(
+            [python, "-c", PEER_READER], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True
+        )
+
+    def reader(self, path):
+        def run():
+            self.process.stdin.write(f"{path}\n")
+            self.process.stdin.flush()
+            answer = self.process.stdout.readline().split()
+            if len(answer) != 2:
+                raise RuntimeError(f"surfalize could not read {path}")
+            return Child((float(answer[0]), float(answer[1]), None))
+
+        return run
+
+    def close(self):
+        self.process.stdin.close()
+        self.process.wait()
+
+
+def x3p_against_surfalize(folder, python, repeat):
+    """rough's X3P read (MD5 checked) against surfalize's (none checked), stored and deflated."""
+    peer = PeerReader(python)
+    repeat = max(repeat, X3P_REPEAT)
+    try:
+        for side in X3P_SIDES:
+            heights = np.random.default_rng(side).standard_normal((side, side)) * 1e-6
+            stored = os.path.join(folder, f"stored-{side}.x3p")
+            rough.Surface(heights, (1e-6, 1e-6)).write(stored)
+            deflated = os.path.join(folder, f"deflated-{side}.x3p")
+            with zipfile.ZipFile(stored) as source, zipfile.ZipFile(deflated, "w", zipfile.ZIP_DEFLATED) as target:
+                for name in source.namelist():
+                    target.writestr(name, source.read(name))
+                member = source.read("bindata/data.bin")
+            for label, path in (("stored", stored), ("deflated", deflated)):
+                compare(
+                    f"X3P read {side}² {label}, MD5 checked",
+                    in_process(lambda path=path: read(path)),
+                    peer.reader(path),
+                    "surfalize, no MD5",
+                    repeat=repeat,
+                    goal="≤ 1× surfalize's",
+                )
+            compare(
+                f"  the MD5 of data.bin alone, {side}²",
+                in_process(lambda member=member: hashlib.md5(member).hexdigest()),
+                peer.reader(stored),
+                "surfalize, stored",
+                repeat=repeat,
+                record=False,
+            )
+    finally:
+        peer.close()
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--size", type=int, default=4096, help="side of the square test map (default 4096)")
     parser.add_argument("--repeat", type=int, default=5, help="paired runs per comparison (default 5)")
+    parser.add_argument("--surfalize", metavar="PYTHON", help="a Python with surfalize: X3P reads against it")
+    parser.add_argument("--x3p-only", action="store_true", help="only the X3P reads against surfalize")
     options = parser.parse_args()
+    if options.surfalize:
+        print(f"rough {rough.__version__} from {pathlib.Path(rough.__file__).parent}, {os.cpu_count()} CPUs")
+        with tempfile.TemporaryDirectory(dir=os.environ.get("TMPDIR")) as folder:
+            x3p_against_surfalize(folder, options.surfalize, options.repeat)
+        if options.x3p_only:
+            return
     heights = np.random.default_rng(0).standard_normal((options.size, options.size)) * 1e-6
     surface = rough.Surface(heights, (1e-6, 1e-6), metadata={"crs": "EPSG:32633"})  # UTM 33N, for GeoTIFF
     print(

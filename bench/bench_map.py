@@ -3,7 +3,9 @@
 * the vectorised moments (Sa … Sz, each window's plane removed in one batch of least squares) against the
   loop they replace, :func:`rough.metrology.remove_form` and the amplitude moments window by window;
 * the same moments as a ratio to one rfft2 of the map (a floor: every spectral command pays it);
-* the fractal fit per window (``hurst``), as a ratio to the moments.
+* the fractal fit per window (``hurst``), as a ratio to the moments;
+* the moments of the map read in bands (a :class:`rough.io.TiledSurface`, as a map larger
+  than memory is) against the map in memory: what cutting the work into bands costs.
 
     python bench/bench_map.py            # a 2048 × 2048 map, windows of 64 points; about two minutes
     python bench/bench_map.py --quick    # 1024 × 1024
@@ -17,6 +19,7 @@ from timing import compare
 
 from rough import Surface, __version__
 from rough.fractal import synthesize_map
+from rough.io import TiledSurface
 from rough.metrology import remove_form, roughness_map
 from rough.metrology.heights import amplitude
 
@@ -46,6 +49,15 @@ def main():
 
     compare("moments, vectorised", moments, lambda: window_loop(surface, window), "per-window loop", repeat, size)
     compare("moments, vectorised", moments, lambda: np.fft.rfft2(surface.heights), "rfft2", repeat, size)
+    tiled = TiledSurface.of(surface)
+    compare(
+        "moments, read in bands",
+        lambda: roughness_map(tiled, window, parameters=MOMENTS, budget=64 << 20),
+        moments,
+        "in memory",
+        repeat,
+        size,
+    )
     part = Surface(surface.heights[: n // 4, : n // 4], surface.spacing)  # the fit is slow: a sixteenth of the map
     compare(
         "hurst (fit per window, 1/16 of the map)",

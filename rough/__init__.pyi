@@ -4,6 +4,7 @@ from . import fractal as fractal
 from . import io as io
 from . import metrology as metrology
 from . import render as render
+from . import tasks as tasks
 from .errors import InputError as InputError
 from .errors import RoughError as RoughError
 from .fractal.fit import fit_fractal as fit_fractal

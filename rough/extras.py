@@ -27,6 +27,7 @@ EXTRAS = {
     "gwyfile": ("writing Gwyddion GWY", "gwyfile", "formats"),
     "rasterio": ("reading and writing GeoTIFF", "rasterio", "formats"),
     "tifffile": ("reading TIFF", "tifffile", "formats"),
+    "distributed": ("--scheduler (a Dask cluster)", "distributed", "cluster"),
 }
 
 

@@ -3,8 +3,9 @@
 Inside rough every length is in metres. rough never guesses a unit: a number in a file
 that names none is in metres (SI) unless the reader is told otherwise, and a length,
 frequency or physical quantity typed on the command line names its unit (``0.1545mm``,
-``30.9um``, ``0.2/mm``, ``1.28N/mm``); zero needs none. (rough 0.12 still reads a bare
-number there in the option's old default unit, with a warning: :func:`is_bare`.)
+``30.9um``, ``0.2/mm``, ``1.28N/mm``); zero needs none. (The command line refuses a
+bare number, :func:`is_bare`, in one line since rough 0.14; 0.12 and 0.13 read it in
+the option's old default unit, with a warning.)
 """
 
 import math

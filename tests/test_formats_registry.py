@@ -228,9 +228,7 @@ def test_the_cli_regrid_option_takes_a_length_and_a_method(run):
     uneven = b"x z\n0 0\n1 1\n3 3\n4 4\n"
     facts = json.loads(run("info", "--json", "--regrid", "0.5m:linear", input=uneven, check=True).stdout)
     assert facts["shape"] == [9] and facts["spacing"] == [0.5]
-    bare = run("info", "--json", "--regrid", "250", input=uneven, check=True)
-    assert json.loads(bare.stdout)["spacing"] == [0.25]  # a bare number is still mm in 0.12, with a warning
-    assert b"a bare number is read as 250 mm" in bare.stderr
+    assert_one_line_error(run("info", "--regrid", "250", input=uneven), "--regrid 250: give a unit, e.g. 250mm")
     assert_one_line_error(run("info", "--regrid", "1um:cubic", input=uneven), "linear or bandlimited")
 
 

@@ -1,6 +1,6 @@
 """``--jobs N``: several inputs on several processes print exactly what one process
 prints, in input order; a bad input, a killed worker and Ctrl-C are handled as with
-one process (rough/cli/batch.py, rough/cli/pool.py)."""
+one process (rough/cli/batch.py, rough/tasks.py)."""
 
 import os
 import pathlib
@@ -14,7 +14,7 @@ import pytest
 import threadpoolctl
 
 import rough
-from rough.cli import pool
+from rough import tasks as pool
 
 from conftest import rough as run
 

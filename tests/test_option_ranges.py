@@ -4,12 +4,18 @@ line with status 2: never status 1, an internal error, a traceback, or an output
 infinite heights. The options are found by walking the command tree, so a new option
 is covered as soon as it exists.
 
+An option that takes a length, a frequency or a physical quantity is fed each extreme
+twice: with its unit (``1e308mm``), which must work or be refused for its size, and
+bare (``1e308``), which rough 0.14 refuses in one line that shows the unit (a bare
+zero needs none).
+
 To keep this quick, one worker process per command runs its cases in-process through
 :func:`rough.cli.main.run`, each with descriptors 1 and 2 sent to files."""
 
 import json
 import os
 import pathlib
+import re
 import subprocess
 import sys
 
@@ -23,23 +29,26 @@ from conftest import assert_one_line_error, rough
 
 EXTREMES = ["1e308", "-1e308", "1e-320", "0", "nan", "inf", "-inf", "1e-9", "1e9"]
 HUGE_INTEGER = "1" + "0" * 30
-# each composite type's values, the extreme put in each of its places (V)
+# each composite type's values, the extreme put in each of its places (V); V[UNIT] is a
+# place that takes a unit, filled both with it and bare
 PLACES = {
-    options.SpacingType: ["V", "V,1um", "1um,V"],
-    options.RegridType: ["V", "V:linear"],
-    options.CropType: ["V:", ":V", "0:V", "V:1e308"],
-    options.FrequencyRangeType: ["V:", ":V", "V:1e308"],
+    options.SpacingType: ["V[mm]", "V[mm],1um", "1um,V[mm]"],
+    options.RegridType: ["V[mm]", "V[mm]:linear"],
+    options.CropType: ["V[mm]:", ":V[mm]", "0:V[mm]", "V[mm]:1e308mm"],
+    options.FrequencyRangeType: ["V[/mm]:", ":V[/mm]", "V[/mm]:1e308/mm"],
     options.RatioPairType: ["V:90", "10:V"],
-    haptics.CouplingType: ["V,0", "1N/mm,V"],
+    haptics.CouplingType: ["V[N/mm],0", "1N/mm,V[N*s/m]"],
     synth.AnisotropyType: [
         "V,1um,2.4,3um,30",
-        "2.2,V,2.4,3um,30",
+        "2.2,V[mm],2.4,3um,30",
         "2.2,1um,V,3um,30",
-        "2.2,1um,2.4,V,30",
+        "2.2,1um,2.4,V[mm],30",
         "2.2,1um,2.4,3um,V",
     ],
     synth.SizeType: ["Vx64", "64xV"],
 }
+PLACE = re.compile(r"V(?:\[([^]]*)\])?")
+BARE = "give a unit, e.g."  # what a refused bare number says
 NOT_NUMBERS = (click.types.StringParamType, click.Choice, click.Path, click.types.BoolParamType)
 SKIPPED = {"show"}  # its own tests (tests/test_show.py)
 
@@ -61,10 +70,29 @@ def numeric_options(command):
                 yield parameter
 
 
+def unit_of(kind):
+    """The unit a single value of this type takes (None for a plain number)."""
+    if isinstance(kind, options.LengthType):
+        return "mm"
+    return kind.default_unit if isinstance(kind, options.QuantityType) else None
+
+
 def values_for(parameter):
-    places = next((p for kind, p in PLACES.items() if isinstance(parameter.type, kind)), ["V"])
+    """``(value, bare)``: each extreme in each place, and ``bare`` when it is a
+    non-zero number given without the unit its place takes."""
+    unit = unit_of(parameter.type)
+    single = [f"V[{unit}]" if unit else "V"]
+    places = next((PLACES[kind] for kind in type(parameter.type).__mro__ if kind in PLACES), single)
     extremes = EXTREMES + ([HUGE_INTEGER] if isinstance(parameter.type, click.types.IntParamType) else [])
-    return [place.replace("V", value) for place in places for value in extremes]
+    values = []
+    for place in places:
+        for value in extremes:
+            if "[" in place:  # with its unit, and bare
+                values.append((PLACE.sub(lambda match, value=value: value + match.group(1), place), False))
+                values.append((PLACE.sub(value, place), value not in ("0", "nan", "inf", "-inf")))
+            else:
+                values.append((PLACE.sub(value, place), False))
+    return values
 
 
 COMMANDS = dict(commands())
@@ -147,8 +175,8 @@ def cases(path, command):
         own = OWN_BASES.get((path[-1], flag))
         bases = [own] if own else [BASES[path], *([PROFILE_BASES[path]] if path in PROFILE_BASES else [])]
         for base in bases:
-            for value in values_for(parameter):
-                yield [*path, *without(base, flag), flag, value]
+            for value, bare in values_for(parameter):
+                yield [*path, *without(base, flag), flag, value], bare
 
 
 WORKER = r"""
@@ -193,7 +221,7 @@ with open(report, "w") as results:
 
 @pytest.mark.parametrize("path", [p for p, c in COMMANDS.items() if any(numeric_options(c))], ids=" ".join)
 def test_every_numeric_option_works_or_is_refused_in_one_line(path, inputs, tmp_path):
-    todo = list(cases(path, COMMANDS[path]))
+    todo, bare = zip(*cases(path, COMMANDS[path]))
     places = inputs
     report = tmp_path / "report.jsonl"
     subprocess.run(
@@ -202,7 +230,7 @@ def test_every_numeric_option_works_or_is_refused_in_one_line(path, inputs, tmp_
     results = [json.loads(line) for line in pathlib.Path(report).read_text().splitlines()]
     assert len(results) == len(todo)
     wrong = []
-    for result in results:
+    for result, refused in zip(results, bare):
         lines = result["stderr"].splitlines()
         errors = [line for line in lines if "warning:" not in line]
         problems = []
@@ -210,6 +238,10 @@ def test_every_numeric_option_works_or_is_refused_in_one_line(path, inputs, tmp_
             problems.append(f"status {result['status']}")
         if result["status"] == 2 and len(errors) != 1:
             problems.append(f"{len(errors)} error lines")
+        if refused and (result["status"] != 2 or BARE not in result["stderr"]):
+            problems.append("a bare number not refused as one")
+        if not refused and BARE in result["stderr"]:
+            problems.append("refused as a bare number")
         if any(word in result["stderr"] for word in ("internal error", "Traceback", "not JSON")):
             problems.append("internal error")
         heights = result["heights"]

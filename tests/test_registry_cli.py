@@ -2,6 +2,10 @@
 choices of options, the devices of --device, the formats convert writes, the
 commands of rough --help; and the rules for option names and bare numbers."""
 
+import json
+
+import click
+import numpy
 import pytest
 
 from rough import metrology, render
@@ -57,55 +61,60 @@ def test_convert_help_names_every_writable_format():
         assert registry.formats()[name].title in convert.epilog
 
 
-def test_hidden_aliases_are_hidden_and_new_names_are_unique():
+def test_no_option_is_hidden_and_each_new_name_has_one_meaning():
+    """rough 0.14 removed the hidden aliases that 0.12 kept for the renamed options."""
     names = {}
     for where, param in every_option():
-        if getattr(param, "hidden", False):
-            assert param.name.startswith("deprecated_"), (where, param.opts)
+        assert not getattr(param, "hidden", False), (where, param.opts)
         for flag in param.opts:
-            names.setdefault(flag, set()).add(param.name.removeprefix("deprecated_"))
-    assert names["--step"] <= {"step", "angle_step"} and names["--rolloff-wavelength"] == {"rolloff_wavelength"}
+            names.setdefault(flag, set()).add(param.name)
+    assert names["--step"] == {"step"} and names["--rolloff-wavelength"] == {"rolloff_wavelength"}
+    assert names["--angle-step"] == {"angle_step"} and names["--spacing"] == {"spacing"}
 
 
-@pytest.mark.parametrize(
-    "old, new",
-    [
-        (["synth", "--length", "1mm", "--spacing", "10um"], ["synth", "--length", "1mm", "--step", "10um"]),
-        (
-            ["synth", "--length", "1mm", "--rolloff", "0.2mm"],
-            ["synth", "--length", "1mm", "--rolloff-wavelength", "0.2mm"],
-        ),
-    ],
-)
-def test_an_old_option_name_still_works_with_one_warning(old, new):
-    common = ["--dimension", "1.3", "--rq", "1um", "--seed", "1", "-f", "tsv"]
-    before, after = rough(*old, *common), rough(*new, *common, check=True)
-    assert before.returncode == 0 and before.stdout == after.stdout
-    assert after.stderr == b""
-    (line,) = before.stderr.decode().splitlines()
-    assert f"{old[3]} is deprecated (rough 0.12): use {new[3]}; it goes in 0.14" in line
+def command_of(where):
+    """The click command ``where`` ("synth", "experiment design") names."""
+    command = cli
+    for name in where.split():
+        command = command.get_command(None, name)
+    return command
 
 
-def test_old_and_new_name_together_is_a_usage_error():
-    result = rough("synth", "--length", "1mm", "--spacing", "10um", "--step", "10um", "--dimension", "1.3")
-    assert result.returncode == 2 and "give --step, not --spacing too" in result.stderr.decode()
+@pytest.mark.parametrize("where, old", list(options.RENAMED), ids=" ".join)
+def test_an_old_option_name_is_refused_in_one_line_that_names_the_new_one(where, old, tmp_path):
+    new, release = options.RENAMED[where, old]
+    command = command_of(where)
+    assert isinstance(command, options.Command)
+    flags = {flag for param in command.params for flag in param.opts}
+    assert old not in flags and new in flags
+    out = tmp_path / "out.x3p"
+    result = rough(*where.split(), old, "1mm", "-o" if where != "show" else "--plot", out, input=b"")
+    assert_one_line_error(result, f"{old} was renamed {new} in rough {release}")
+    assert not out.exists()
+
+
+def test_an_unknown_option_is_still_clicks_usage_error():
+    assert_one_line_error(rough("synth", "--spacing-typo", "1mm"), "No such option '--spacing-typo'")
+    assert_one_line_error(rough("detrend", "--input-spacing", "1mm", input=b""), "No such option")
+
+
+def test_resample_takes_the_input_spacing_as_spacing_like_every_command(tmp_path):
+    heights = tmp_path / "column.npy"
+    numpy.save(heights, numpy.sin(numpy.arange(400) / 7.0) * 1e-6)
+    result = rough("resample", "--spacing", "1um", "--step", "2um", "-f", "tsv", heights, check=True)
+    coarse = json.loads(rough("info", "--json", input=result.stdout, check=True).stdout)
+    assert coarse["spacing"] == pytest.approx([2e-6]) and coarse["shape"] == [200]
+    assert_one_line_error(rough("resample", "--step", "2um", heights), "--spacing")
 
 
 def test_resample_asks_for_its_step_before_it_reads_or_makes_anything(tmp_path):
     for args, stdin in ((["resample"], b""), (["resample", str(tmp_path / "absent.x3p")], None)):
         assert_one_line_error(run(*args, input=stdin), "Missing option '--step'")
-    result = run("resample", rough_sample("rock-profile.tsv"), rough_sample("rock-map.x3p"), "-o", tmp_path / "out/")
-    assert result.returncode == 2 and not (tmp_path / "out").exists()
-
-
-@pytest.mark.parametrize(
-    "args",
-    [["render", "--speed", "-1"], ["resample", "--step", "-1"], ["fit-fractal", "--band", "0:1"]],
-)
-def test_a_refused_bare_number_is_one_line_without_the_bare_number_warning(args):
-    result = run(*args, rough_sample("rock-profile.tsv"))
-    assert result.returncode == 2 and len(result.stderr.decode().splitlines()) == 1
-    assert "bare number" not in result.stderr.decode()
+    # the new spacing as 0.12 spelled it is now the input's: still no --step
+    old = ["resample", "--spacing", "0.1545mm", rough_sample("rock-profile.tsv"), rough_sample("rock-map.x3p")]
+    result = run(*old, "-o", tmp_path / "out/")
+    assert result.returncode == 2 and "Missing option '--step'" in result.stderr.decode()
+    assert not (tmp_path / "out").exists()
 
 
 def profile():
@@ -115,30 +124,39 @@ def profile():
 @pytest.mark.parametrize(
     "bare, named, said",
     [
-        (["--cutoff", "0.8"], ["--cutoff", "0.8mm"], "--cutoff 0.8: a bare number is read as 0.8 mm"),
-        (["--crop", "0.5:2"], ["--crop", "0.5mm:2mm"], "--crop 0.5: a bare number is read as 0.5 mm"),
+        (["detrend", "--cutoff", "0.8"], ["detrend", "--cutoff", "0.8mm"], "--cutoff 0.8: give a unit, e.g. 0.8mm"),
+        (["detrend", "--crop", "0.5:2"], ["detrend", "--crop", "0.5mm:2mm"], "--crop 0.5: give a unit, e.g. 0.5mm"),
+        (["detrend", "--crop", "0:2"], ["detrend", "--crop", "0:2mm"], "--crop 2: give a unit, e.g. 2mm"),
+        (["detrend", "--spacing", "1um,2"], ["detrend", "--spacing", "1um"], "--spacing 2: give a unit, e.g. 2mm"),
+        (["info", "--regrid", "0.01"], ["info", "--regrid", "0.01mm"], "--regrid 0.01: give a unit, e.g. 0.01mm"),
+        (["fit-fractal", "--band", "0.5:20/mm"], ["fit-fractal", "--band", "0.5/mm:20/mm"], "--band 0.5: give a unit"),
+        (["render", "--speed", "40"], ["render", "--speed", "40mm/s"], "--speed 40: give a unit, e.g. 40mm/s"),
+        (["render", "--coupling", "1,0"], ["render", "--coupling", "1N/mm,0"], "--coupling 1: give a unit, e.g. 1N/mm"),
     ],
 )
-def test_a_bare_length_is_read_in_mm_with_a_warning(bare, named, said):
+def test_a_bare_number_is_refused_in_one_line_that_shows_the_unit(bare, named, said):
     surface = profile()
-    warned = rough("detrend", "-f", "tsv", *bare, input=surface)
-    quiet = rough("detrend", "-f", "tsv", *named, input=surface, check=True)
-    assert warned.returncode == 0 and warned.stdout == quiet.stdout and quiet.stderr == b""
-    (line,) = warned.stderr.decode().splitlines()
-    assert said in line and "write the unit (bare numbers are refused from rough 0.14)" in line
+    refused = rough(*bare, "--json" if bare[0] in ("fit-fractal", "render", "info") else "-ftsv", input=surface)
+    assert_one_line_error(refused, said)
+    assert refused.stdout == b""
+    unit = {"--band": "per mm", "--speed": "mm/s", "--coupling": "N/mm"}.get(bare[1], "mm")
+    assert f"(bare numbers were read as {unit} until rough 0.13)" in refused.stderr.decode()
+    rough(*named, "--json" if named[0] in ("fit-fractal", "render", "info") else "-ftsv", input=surface, check=True)
 
 
-def test_a_bare_frequency_is_per_mm_and_a_bare_quantity_in_its_old_unit_with_a_warning():
-    surface = profile()
-    warned = rough("fit-fractal", "--json", "--band", "0.5:20", input=surface)
-    named = rough("fit-fractal", "--json", "--band", "0.5/mm:20/mm", input=surface, check=True)
-    assert warned.stdout == named.stdout and "--band 0.5: a bare number is read as 0.5 /mm" in warned.stderr.decode()
-    assert len(warned.stderr.decode().splitlines()) == 1  # one warning for the option, not one per end
-    speed = rough("render", "--json", "--speed", "40", input=surface)
-    assert speed.returncode == 0 and "--speed 40: a bare number is read as 40 mm/s" in speed.stderr.decode()
+def test_a_bare_reference_rq_is_refused_before_the_study_is_written(tmp_path):
+    study = tmp_path / "study"
+    refused = rough("experiment", "design", "--reference", "1.275,0.2781", "--subjects", "1", study)
+    assert_one_line_error(refused, "--reference 0.2781: give a unit, e.g. 0.2781mm (bare numbers were read as mm")
+    assert not study.exists()
+    rough("experiment", "design", "--reference", "1.275,0.2781mm", "--subjects", "1", "--seed", "1", study, check=True)
 
 
 def test_zero_needs_no_unit():
+    for text in ("0", "0.0", "-0", " 0e5 "):
+        options.bare_number(text, "--height", "mm")  # not refused
+    with pytest.raises(click.UsageError, match="^--height 1e-3: give a unit, e.g. 1e-3mm"):
+        options.bare_number("1e-3", "--height", "mm")
     result = rough("detrend", "-f", "tsv", "--crop", "0:2mm", input=profile(), check=True)
     assert result.stderr == b""
 

@@ -202,3 +202,87 @@ def test_a_profile_is_refused(tmp_path, run):
     source = tmp_path / "p.npy"
     np.save(source, np.random.default_rng(0).standard_normal(500) * 1e-6)
     assert_one_line_error(run("map", source, "--spacing", "1um", "--window", "32px"), "not a profile")
+
+
+# -- a map larger than memory, read a band of windows at a time (issue 34, item 2 on tiles) --
+
+
+@pytest.mark.parametrize(
+    ("window", "step", "parameters"),
+    [(32, 32, ["Sq", "Sa", "Ssk", "Sku", "Sz"]), (20, 7, ["Sq", "Sdq", "Str", "lay"]), (32, 24, ["Sq", "hurst"])],
+)
+def test_tiled_and_parallel_maps_equal_the_map_in_memory_bit_for_bit(window, step, parameters):
+    heights = quadrants(3)
+    heights[5:40, 10:30] = np.nan  # windows with too few points, and holes the fractal fit refuses
+    heights[50, 100] = np.nan
+    surface = rough.Surface(heights, 10e-6, origin=(2.0, -1.0), metadata={"crs": "EPSG:32633"})
+    whole = roughness_map(surface, window, step=step, parameters=parameters)
+    assert whole.tiled is None
+    for kind, result in [
+        ("tiled", roughness_map(rough.io.TiledSurface.of(surface), window, step=step, parameters=parameters)),
+        ("tiled, small bands", roughness_map(rough.io.TiledSurface.of(surface), window, step, parameters, budget=1)),
+        ("two jobs", roughness_map(surface, window, step=step, parameters=parameters, jobs=2)),
+        ("tiled, two jobs", roughness_map(rough.io.TiledSurface.of(surface), window, step, parameters, jobs=2)),
+    ]:
+        for name in parameters:
+            assert result.values[name].tobytes() == whole.values[name].tobytes(), (kind, name)
+        assert result.reasons == whole.reasons and list(result.reasons) == list(whole.reasons), kind
+        assert (result.origin, result.spacing, result.metadata) == (whole.origin, whole.spacing, whole.metadata)
+        assert (result.tiled is not None) == kind.startswith("tiled"), kind
+    tiled = roughness_map(rough.io.TiledSurface.of(surface), window, step=step, parameters=parameters)
+    assert tiled.tiled["exact"] == parameters and tiled.tiled["estimated"] == {}
+    assert tiled.as_dict()["tiled"] == tiled.tiled and "tiled" not in whole.as_dict()
+
+
+@pytest.fixture(scope="module")
+def large_dem(tmp_path_factory):
+    """A 2048² GeoTIFF in a projected CRS, in 256-point blocks, deflated."""
+    rasterio = pytest.importorskip("rasterio")
+    path = tmp_path_factory.mktemp("large") / "dem.tif"
+    rng = np.random.default_rng(11)
+    heights = (rng.standard_normal((2048, 2048)).cumsum(axis=1) * 0.01).astype(np.float32)
+    heights[300:340, 500:900] = np.nan
+    profile = {
+        "driver": "GTiff",
+        "width": 2048,
+        "height": 2048,
+        "count": 1,
+        "dtype": "float32",
+        "crs": "EPSG:32633",
+        "transform": rasterio.Affine(2.0, 0.0, 500000.0, 0.0, -2.0, 5102048.0),
+        "nodata": float("nan"),
+        "tiled": True,
+        "blockxsize": 256,
+        "blockysize": 256,
+        "compress": "deflate",
+    }
+    with rasterio.open(path, "w", **profile) as dataset:
+        dataset.write(heights, 1)
+    return path
+
+
+def test_rough_map_of_a_dem_too_large_for_memory_is_the_same_geotiff(large_dem, tmp_path, run):
+    rasterio = pytest.importorskip("rasterio")
+    common = ["map", large_dem, "--window", "64px", "--step", "48px", "--parameters", "Sq,Ssk"]
+    run(*common, "-o", tmp_path / "whole.tif", check=True)
+    tiled = run("-v", *common, "--memory", "64MB", "-o", tmp_path / "tiled.tif", check=True)
+    assert b"read in tiles" in tiled.stderr  # 2048² × 80 bytes: over 64 MB
+    run(*common, "--memory", "64MB", "--jobs", "2", "-o", tmp_path / "jobs.tif", check=True)
+    whole = (tmp_path / "whole.tif").read_bytes()
+    assert (tmp_path / "tiled.tif").read_bytes() == whole == (tmp_path / "jobs.tif").read_bytes()
+    with rasterio.open(large_dem) as dem, rasterio.open(tmp_path / "tiled.tif") as result:
+        assert result.crs == dem.crs
+        assert result.descriptions == ("Sq", "Ssk")
+        assert (result.width, result.height) == ((2048 - 64) // 48 + 1,) * 2
+        # the first window's centre: 31.5 points in from the DEM's west edge's first pixel centre
+        assert result.transform.a == 96.0 and result.transform.c == pytest.approx(500000.0 + 32 * 2.0 - 48.0)
+    summary = run(*common, "--memory", "64MB", check=True).stdout.decode()
+    assert "every window computed whole (exact)" in summary
+
+
+def test_rough_show_draws_a_band_of_the_map(large_dem, tmp_path, run):
+    pytest.importorskip("matplotlib")
+    out = tmp_path / "map.tif"
+    run("map", large_dem, "--window", "256px", "--parameters", "Sq,lay", "--memory", "64MB", "-o", out, check=True)
+    run("show", out, "--channel", "lay", "--plot", tmp_path / "lay.png", check=True)
+    assert (tmp_path / "lay.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

@@ -408,6 +408,40 @@ def flooded_and_descended(image):
     return flooded, flooding.descend(filled, valid, markers)
 
 
+def tied_pits(image):
+    """Whether two pits (markers) of ``image`` have one height: where they meet,
+    rough's rule (the pit first in row-major order) and scikit-image's heap may
+    differ."""
+    valid = ~np.isnan(image)
+    filled = np.where(valid, image, np.nanmax(image))
+    markers, count = flooding.basin_markers(filled, valid)
+    levels = ndimage.minimum(filled, markers, np.arange(1, count + 1))
+    return np.unique(levels).size < count
+
+
+def takes_a_lowest_neighbour(image, labels):
+    """Whether every valid point that is not a pit and has a lower neighbour carries
+    the label of one of its lowest neighbours (what any flood gives)."""
+    valid = ~np.isnan(image)
+    filled = np.where(valid, image, np.inf)
+    markers, _ = flooding.basin_markers(np.where(valid, image, np.nanmax(image)), valid)
+    padded = np.pad(filled, 1, constant_values=np.inf)
+    padded_labels = np.pad(labels, 1)
+    ny, nx = image.shape
+    near = [
+        (padded[1 + r : 1 + r + ny, 1 + c : 1 + c + nx], padded_labels[1 + r : 1 + r + ny, 1 + c : 1 + c + nx])
+        for r in (-1, 0, 1)
+        for c in (-1, 0, 1)
+        if r or c
+    ]
+    lowest = np.min([heights for heights, _ in near], axis=0)
+    among = np.zeros(image.shape, bool)
+    for heights, neighbour_labels in near:
+        among |= (heights == lowest) & (neighbour_labels == labels)
+    checked = valid & (markers == 0) & (lowest < filled)
+    return bool(among[checked].all())
+
+
 @st.composite
 def images(draw):
     """Small maps of float heights (smooth or rough), of a few levels (plateaus and
@@ -418,7 +452,7 @@ def images(draw):
     if draw(st.booleans()) and min(shape) > 1:
         image = ndimage.gaussian_filter(image, draw(st.floats(0.5, 3.0)))
     if draw(st.booleans()):
-        image = np.round(image * draw(st.sampled_from([1.0, 3.0, 30.0])))
+        image = np.round(image * draw(st.sampled_from([1.0, 3.0, 30.0, 1000.0, 10000.0])))
     if draw(st.booleans()):
         image[rng.random(shape) < draw(st.floats(0.0, 0.5))] = np.nan
     if np.isnan(image).all():
@@ -429,8 +463,43 @@ def images(draw):
 @settings(max_examples=400, deadline=None)
 @given(images())
 def test_the_descent_is_the_flood_wherever_it_decides(image):
+    """Equal to scikit-image's flood unless two pits have one height (there rough's
+    rule decides, scikit-image's heap history may differ); a flood's labels either way."""
     flooded, descended = flooded_and_descended(image)
-    assert descended is None or np.array_equal(descended, flooded)
+    if descended is None:
+        return
+    assert takes_a_lowest_neighbour(image, descended)
+    if not tied_pits(image):
+        assert np.array_equal(descended, flooded)
+
+
+def same_regions(one, other):
+    """Whether two labellings cut the map into the same regions (numbers aside)."""
+    pairs = np.unique(np.stack([one.ravel(), other.ravel()]), axis=1)
+    return pairs.shape[1] == np.unique(one).size == np.unique(other).size
+
+
+TRANSFORMS = (np.transpose, np.fliplr, np.flipud, lambda a: np.rot90(a, 1), lambda a: np.rot90(a, 2))
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.integers(1, 20), st.integers(1, 20), st.integers(0, 2**32 - 1), st.floats(0.0, 0.4), st.booleans())
+def test_the_descent_turns_with_a_map_without_ties(ny, nx, seed, holes, smooth):
+    """On a map of distinct heights the regions follow the map through a transpose, a
+    flip, a rotation: no order of traversal enters them."""
+    rng = np.random.default_rng(seed)
+    image = rng.permutation(ny * nx).reshape(ny, nx).astype(float)
+    if smooth and min(ny, nx) > 1:
+        image = np.argsort(np.argsort(ndimage.gaussian_filter(image, 1.5).ravel(), kind="stable"))
+        image = image.reshape(ny, nx).astype(float)  # smooth, still distinct ranks
+    image[rng.random(image.shape) < holes] = np.nan
+    if np.isnan(image).all():
+        image[0, 0] = 1.0
+    descended = flooded_and_descended(image)[1]
+    assert descended is not None
+    for transform in TRANSFORMS:
+        turned = flooded_and_descended(np.ascontiguousarray(transform(image)))[1]
+        assert same_regions(turned, transform(descended))
 
 
 @pytest.mark.parametrize("seed", range(4))
@@ -441,20 +510,63 @@ def test_the_descent_decides_on_float_heights(seed):
     assert descended is not None and np.array_equal(descended, flooded)
 
 
-def test_a_plateau_leaves_it_to_the_flood():
+@pytest.mark.parametrize("seed", [1, 2, 4, 5])
+def test_the_descent_settles_ties_and_small_plateaus_as_the_flood(seed):
+    """Smooth heights rounded to a fine step: ties between neighbours and small raised
+    plateaus, which the descent once left to scikit-image."""
+    image = np.round(smoothed_noise((160, 150), seed, 2.0) * 1e10) / 1e4
+    image[70:74, 30:90] = np.nan
+    flooded, descended = flooded_and_descended(image)
+    assert np.sum(image[:, 1:] == image[:, :-1]) >= 10  # ties there are
+    assert descended is not None and np.array_equal(descended, flooded)
+
+
+def test_a_plateau_is_flooded_as_the_flood_does():
     image = smoothed_noise((40, 40), 1)
     image[10:20, 10:20] = image[10:20, 10:20].max()  # a raised plateau, lower on some sides
-    assert flooded_and_descended(image)[1] is None
+    flooded, descended = flooded_and_descended(image)
+    assert descended is not None and np.array_equal(descended, flooded)
+    image = np.array([[0.0, 1.0, 2.0, 2.0, 2.0, 1.0, 0.5]])  # the exit above the lower descent is taken first
+    flooded, descended = flooded_and_descended(image)
+    assert np.array_equal(descended, flooded) and descended.tolist() == [[1, 1, 1, 1, 2, 2, 2]]
     image = np.round(smoothed_noise((40, 40), 1) * 3e6)  # three levels or so: ties everywhere
     assert flooded_and_descended(image)[1] is None
 
 
-def test_a_point_between_two_basins_at_one_height_leaves_it_to_the_flood():
-    image = np.array([[0.0, 2.0, 3.0, 2.0, 0.0]])  # 3's two lowest neighbours (2, 2) lie in two basins
-    assert flooded_and_descended(image)[1] is None
+def test_a_point_between_two_basins_at_one_height_takes_the_first_reached():
+    image = np.array([[0.0, 2.0, 3.0, 2.0, 0.0]])  # 3's two lowest neighbours reached from two equal pits
+    assert flooded_and_descended(image)[1].tolist() == [[1, 1, 1, 2, 2]]  # rough's rule
+    for image in ([[0.0, 1.0, 2.0, 3.0, 2.0, 0.5]], [[0.5, 1.0, 2.0, 3.0, 2.0, 0.0]]):
+        flooded, descended = flooded_and_descended(np.array(image))  # the 2 above the lower pit is reached first
+        assert np.array_equal(descended, flooded) and descended[0, 3] == 2
     image = np.array([[0.0, 2.0, 3.0, 2.5, 0.0]])
     flooded, descended = flooded_and_descended(image)
     assert np.array_equal(descended, flooded) and descended.tolist() == [[1, 1, 1, 2, 2]]
+
+
+def test_two_equal_pits_at_one_point_give_it_to_the_pit_first_in_row_major_order():
+    """rough's rule for tied pits, where scikit-image's heap history decides: the pit
+    whose first point comes first in row-major order wins, whichever of its points
+    the tied point touches and in whatever orientation the map is given."""
+    assert flooded_and_descended(np.array([[0.0, 2.0, 0.0]]))[1].tolist() == [[1, 1, 2]]
+    assert flooded_and_descended(np.array([[0.0], [2.0], [0.0]]))[1].tolist() == [[1], [1], [2]]
+    image = np.array(  # pit A, column 2 (first point (0, 2)); pit B at (2, 0), touched before A
+        [
+            [9.0, 8.0, 0.0],
+            [7.0, 6.0, 0.0],
+            [0.0, 4.0, 0.0],
+            [3.0, 5.0, 0.0],
+        ]
+    )
+    descended = flooded_and_descended(image)[1]
+    assert descended.tolist() == [[1, 1, 1], [2, 1, 1], [2, 1, 1], [2, 1, 1]]
+    for transform in TRANSFORMS:
+        turned = np.ascontiguousarray(transform(image))
+        labels = flooded_and_descended(turned)[1]
+        pits = [np.flatnonzero((labels.ravel() == label) & (turned.ravel() == 0))[0] for label in (1, 2)]
+        assert pits[0] < pits[1]  # markers are numbered in row-major order of their first point
+        point = np.flatnonzero(turned.ravel() == 5.0)[0]
+        assert labels.ravel()[point] == 1  # the one between: the pit first in row-major order
 
 
 def regions_by_hand(filled, labels):
@@ -535,6 +647,8 @@ def quantised_images(draw):
 @settings(max_examples=150, deadline=None)
 @given(quantised_images(), st.sampled_from(["hills", "dales"]), st.sampled_from([0.0, 5.0, 30.0]))
 def test_the_two_routes_give_the_same_labels(image, kind, pruning):
+    """The same labels and motifs, ties included: where two pits have one height,
+    both routes take the descent's regions (rough's rule), not scikit-image's heap."""
     surface = Surface(image * 1e-6, DX)
     routes = []
     for threshold in (0, math.inf):  # compiled passes everywhere, then array operations everywhere

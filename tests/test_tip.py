@@ -463,7 +463,7 @@ def test_detrend_tip_and_envelope_commands():
         "synth",
         "--length",
         "5mm",
-        "--spacing",
+        "--step",
         "10um",
         "--dimension",
         "1.3",

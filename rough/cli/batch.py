@@ -5,24 +5,27 @@ Side files (``--plot``, ``--psd``, ``--list``, ``--segments``) then need ``{stem
 input's name without directory and extension) or ``{name}`` in their names, and a
 surface output ``-o`` names a directory (``out/``).
 
-With ``--jobs N`` (N > 1) the inputs are worked on by N forked processes
-(:mod:`rough.cli.pool`) and everything is printed by this process in input order, as
-with one: each worker keeps its input's log lines, warnings, report and error line
+With ``--jobs N`` (N > 1) the inputs are worked on by N forked processes, and with
+``--scheduler ADDRESS`` by the workers of a Dask cluster, each input a task
+(:func:`rough.tasks.outcomes`); everything is printed by this process in input order,
+as with one: each worker keeps its input's log lines, warnings, report and error line
 and sends them back, so that standard output and standard error read as they would
-one input after another. Side files are written by the workers.
+one input after another. Side files and ``-o`` outputs are written by the workers
+(on a cluster, to the file system they share with this machine).
 """
 
 import contextlib
 import dataclasses
+import functools
 import logging
 import os
 import sys
+import warnings
 
 import click
 
-from .. import errors, io, progress
-from . import pool
-from .main import current_input, failure, say
+from .. import errors, io, progress, tasks
+from .main import _warn_in_one_line, current_input, failure, say
 from .report import Printer, collected_warnings
 
 log = logging.getLogger("rough")
@@ -43,6 +46,7 @@ def run_each(work, names, options):
     many = len(names) > 1
     check_inputs(names)
     jobs = options.pop("jobs", 1)
+    scheduler = options.pop("scheduler", None)
     printer = Printer(options.pop("as_json", False), options.pop("as_tsv", False), many)
     side = {key: options[key] for key in SIDE_FILES if options.get(key)}
     if many:
@@ -51,12 +55,16 @@ def run_each(work, names, options):
             options["output"].check_directory(names)
     elif "output" in options:
         options["output"].check()
+    if scheduler is not None:
+        if "-" in names:
+            raise click.UsageError("standard input (-) cannot be sent to a cluster: give files (--scheduler)")
+        return _in_parallel(work, names, options, side, printer, scheduler=scheduler)
     if many:
-        jobs, note = pool.usable_jobs(jobs, len(names))
+        jobs, note = tasks.usable_jobs(jobs, len(names))
         if note:
             log.warning(note)
         if jobs > 1:
-            return _in_parallel(work, names, options, side, printer, jobs)
+            return _in_parallel(work, names, options, side, printer, jobs=jobs)
     status = 0
     for name in _progress(names, many):
         report, warnings, failed = _one(work, name, _named(options, side, name), many)
@@ -67,7 +75,10 @@ def run_each(work, names, options):
 
 
 def read_named(name, options):
-    """The surface in input ``name`` (see :func:`rough.io.read`)."""
+    """The surface in input ``name`` (see :func:`rough.io.read`); with a ``memory``
+    option, a tiled one when it is too large for it (:func:`rough.io.open_surface`)."""
+    if "memory" in options:
+        return io.open_surface(name, **options)
     return io.read(name, **options)
 
 
@@ -124,22 +135,25 @@ class _Outcome:
     stop: tuple = None  # a click error that ends the command: (usage?, message, exit status)
 
 
-def _in_parallel(work, names, options, side, printer, jobs):
-    """:func:`run_each`'s loop over ``jobs`` worker processes; the exit status."""
-
-    def task(index):
-        return _in_worker(work, names[index], _named(options, side, names[index]))
-
+def _in_parallel(work, names, options, side, printer, jobs=1, scheduler=None):
+    """:func:`run_each`'s loop over ``jobs`` worker processes or a cluster's workers
+    (:func:`rough.tasks.outcomes`); the exit status."""
+    logger = logging.getLogger("rough")
+    levels = logger.level, min((handler.level for handler in logger.handlers), default=logging.WARNING)
+    task = functools.partial(_in_worker, work, levels, len(names) > 1)
+    items = [(name, _named(options, side, name)) for name in names]
     status = 0
     with (
         progress.progress(total=len(names), description="files", unit="file") as bar,
-        contextlib.closing(pool.ordered(task, len(names), jobs, lambda: bar.update(1))) as outcomes,
+        contextlib.closing(
+            tasks.outcomes(task, items, jobs=jobs, scheduler=scheduler, finished=lambda: bar.update(1))
+        ) as outcomes,
     ):
         for name, outcome in zip(names, outcomes):
-            report, warnings, failed = _replay(name, outcome)
+            report, warned, failed = _replay(name, outcome, len(names) > 1)
             status = max(status, failed)
             if report is not None:
-                printer.print(report, name, warnings)
+                printer.print(report, name, warned)
     return status
 
 
@@ -154,28 +168,36 @@ class _Kept(logging.Handler):
         self.records.append((record.levelno, record.getMessage()))
 
 
-def _in_worker(work, name, options):
-    """One input in a worker process: an :class:`_Outcome`, nothing printed."""
+def _in_worker(work, levels, many, item):
+    """One input ``item`` = (name, options) in a worker process (forked, or a cluster's):
+    an :class:`_Outcome`, nothing printed; the parent's logger and handler ``levels``."""
+    name, options = item
     logger = logging.getLogger("rough")
     if not any(isinstance(handler, _Kept) for handler in logger.handlers):
-        level = min((handler.level for handler in logger.handlers), default=logging.WARNING)
-        logger.handlers[:] = [_Kept(level)]
+        logger.handlers[:] = [_Kept(levels[1])]
+        logger.setLevel(levels[0])
+        logger.propagate = False
         progress.configure(False)
     kept = next(handler for handler in logger.handlers if isinstance(handler, _Kept))
     kept.records = []
     try:
-        report, warnings, status, message = _attempt(work, name, options, True)
+        with warnings.catch_warnings():  # as the command line shows them (rough.cli.main)
+            warnings.filterwarnings("ignore", category=RuntimeWarning)
+            warnings.showwarning = _warn_in_one_line
+            report, warned, status, message = _attempt(work, name, options, many)
     except click.ClickException as error:
         stop = (isinstance(error, click.UsageError), error.format_message(), error.exit_code)
         return _Outcome(log=kept.records, stop=stop)
-    return _Outcome(report, warnings, status, message, kept.records)
+    return _Outcome(report, warned, status, message, kept.records)
 
 
-def _replay(name, outcome):
+def _replay(name, outcome, many):
     """Print, in this process, what a worker logged for input ``name``; (report,
-    warnings, status) as :func:`_one` returns them."""
-    if isinstance(outcome, (pool.Died, pool.Failed)):
-        say(f"{printable_name(name)}: {outcome.message() if isinstance(outcome, pool.Died) else outcome.message}")
+    warnings, status) as :func:`_one` returns them. With one input its error is raised."""
+    if isinstance(outcome, tasks.Failed) and outcome.error is not None and not many:
+        raise outcome.error
+    if isinstance(outcome, (tasks.Died, tasks.Failed)):
+        say(f"{printable_name(name)}: {outcome.message() if isinstance(outcome, tasks.Died) else outcome.message}")
         return None, [], 1
     current_input[:] = [printable_name(name)]
     try:

@@ -3,7 +3,8 @@
 import click
 
 from ..io import registry
-from .options import jobs_option, surface_input, surface_output
+from .options import surface_input, surface_output
+from .work_options import jobs_option
 
 
 class WritesCommand(click.Command):

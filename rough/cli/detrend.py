@@ -4,7 +4,8 @@ and what a round tip traces (the ISO 16610-41 closing envelope)."""
 import click
 
 from .. import metrology
-from .options import LENGTH, TIP, RegistryChoice, crop_option, jobs_option, surface_input, surface_output
+from .options import LENGTH, TIP, RegistryChoice, crop_option, surface_input, surface_output
+from .work_options import jobs_option
 
 
 @click.command(short_help="Remove polynomial form; split roughness and waviness (ISO 16610); trace with a round tip.")

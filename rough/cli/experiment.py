@@ -11,7 +11,7 @@ from .. import extras, io, plots, render
 from ..errors import InputError
 from ..units import format_length, parse_length
 from .haptics import SPEED, TIME, haptic_options
-from .options import LENGTH, LENGTHS, FloatRange, bare_number, plot_option, renamed, report_format
+from .options import LENGTH, LENGTHS, Command, FloatRange, bare_number, plot_option, report_format
 from .report import Report, collected_warnings, emit
 
 
@@ -32,7 +32,7 @@ def experiment():
     """
 
 
-@experiment.command(short_help="Write a study folder: surfaces with recorded seeds and the trial list.")
+@experiment.command(cls=Command, short_help="Write a study folder: surfaces with recorded seeds and the trial list.")
 @click.argument("study", metavar="STUDY")
 @click.option(
     "--preset",
@@ -57,9 +57,7 @@ def experiment():
 )
 @click.option("--length", type=LENGTH, help="Profile length (default 80 mm).")
 @click.option("--step", type=LENGTH, help="Spacing of the surfaces stored and rendered (default 0.1545 mm).")
-@renamed("--spacing", "--step", "step", LENGTH)
 @click.option("--synthesis-step", type=LENGTH, help="Spacing the surfaces are synthesised at (default 0.0309 mm).")
-@renamed("--synthesis-spacing", "--synthesis-step", "synthesis_step", LENGTH)
 @click.option(
     "--seed", type=click.IntRange(0), help="Seed of the surfaces and the randomisation (default: drawn and recorded)."
 )
@@ -145,7 +143,7 @@ def _reference(text):
     if not 1 < dimension < 2:
         raise InputError(f"--reference {text!r}: a profile's D lies between 1 and 2")
     bare_number(parts[1], "--reference", "mm")
-    rq = parse_length(parts[1], "mm")
+    rq = parse_length(parts[1])
     if not LENGTHS[0] <= rq <= LENGTHS[1]:
         raise InputError(f"--reference {text!r}: Rq must lie between 1 pm and 10000 km")
     return dimension, rq

@@ -15,16 +15,16 @@ from .options import (
     FloatRange,
     RegistryChoice,
     crop_option,
-    jobs_option,
     plot_option,
     report_format,
-    surface_input,
+    tiled_input,
 )
 from .report import Report, on_stdout, shown
+from .work_options import jobs_option
 
 
 @click.command(short_help="ISO parameters (Ra…JRC, Sa…Std), amplitude density, feature detection.")
-@surface_input
+@tiled_input
 @jobs_option
 @crop_option
 @click.option(
@@ -174,6 +174,7 @@ def features(
     segments,
     vs_length,
     plot,
+    work,
 ):
     """Parameters of INPUT (default: standard input) computed on the data as given,
     with only the mean of the valid points removed (pipe through `rough detrend`
@@ -198,6 +199,21 @@ def features(
         rough features --pruning 10 --segments motifs.tsv scan.x3p
         rough features --vs-length rock.tsv
     """
+    if isinstance(surface, io.TiledSurface):
+        untiled = {
+            "--cutoff": cutoff,
+            "--along": along,
+            "--plot": plot,
+            "--segments": segments,
+            "--list": feature_list,
+            "--vs-length": vs_length,
+        }
+        settings = Settings(
+            None, None, slope, jrc_spacing, None, material_height, material_ratio, dc_ratios, volume_ratios, acf
+        )
+        return _tiled(
+            surface, settings, pruning, edge_features, [name for name, given in untiled.items() if given], work
+        )
     report = not on_stdout(list=feature_list, plot=plot, segments=segments)
     evaluated = surface if cutoff is None else metrology.split(surface, cutoff, "roughness", ends)
     settings = Settings(
@@ -341,6 +357,64 @@ def _parameter_rows(surface, values, functional, settings):
             "JRC = %.4g is outside the 0–20 range the Tse–Cruden relation was calibrated on", values["JRC"]
         )
     return rows, {**values, **functional, "evaluation": evaluation}
+
+
+def _tiled(surface, settings, pruning, edges, untiled, work):
+    """The report of a map read in tiles (:func:`rough.metrology.tiled_evaluation`)."""
+    if untiled:
+        raise errors.InputError(
+            f"{', '.join(untiled)} cannot be had on a map read in tiles; crop it, or give a larger --memory"
+        )
+    found = metrology.tiled_evaluation(
+        surface,
+        slope=settings.slope,
+        acf=settings.acf,
+        height=settings.height,
+        ratio=settings.ratio,
+        dc_ratios=settings.dc_ratios,
+        volume_ratios=settings.volume_ratios,
+        pruning=pruning,
+        edges=edges,
+        **work,
+    )
+    values, section = found.values, found.section
+    extent = " × ".join(units.format_length(s) for s in surface.size)
+    basis = "data as given, mean removed"
+    evaluation = {
+        "points": surface.point_count,
+        "valid_points": found.count,
+        "size": list(surface.size),
+        "basis": basis,
+        "slope": settings.slope,
+        "jrc_spacing": settings.jrc_spacing,
+        "cutoff": None,
+        "acf": settings.acf,
+        "material_ratio": {
+            "height": settings.height,
+            "ratio": settings.ratio,
+            "dc_ratios": list(settings.dc_ratios),
+            "volume_ratios": list(settings.volume_ratios),
+        },
+        "segmentation": _segmentation(pruning, edges, values["Sz"])["settings"],
+    }
+    unit = {"points": "points", "valid_points": "points", "size": "m", "jrc_spacing": "m", "cutoff": "m"}
+    unit |= {"material_ratio": {"height": "m", "ratio": "%", "dc_ratios": "%", "volume_ratios": "%"}}
+    unit["segmentation"] = {"pruning": "%", "threshold": "m"}
+    text = f"{extent}, {found.count} of {surface.point_count} points valid; {basis}"
+    rows = [("evaluation", evaluation, unit, text)]
+    estimated = ", ".join(section["estimated"])
+    tiles = f"read in {section['tiles']} strips of {section['tile_rows']} rows; estimated: {estimated}"
+    if section["undefined"]:
+        tiles += f"; undefined on tiles: {', '.join(section['undefined'])}"
+    rows.append(("tiled", section, {"tile_rows": "rows", "spectrum_tile": "points", "pruning": "%"}, tiles))
+    notes = _notes(surface, values, settings, None)
+    notes |= {key: "; ".join(filter(None, (notes.get(key), "estimated"))) for key in section["estimated"]}
+    for table in (metrology.AREAL, metrology.AREAL_FUNCTIONAL, metrology.FEATURE):
+        rows += _value_rows(values, table, notes)
+    centres, density = found.density
+    document = {**values, "evaluation": evaluation, "tiled": section}
+    document["amplitude_density"] = {"height": centres.tolist(), "density": density.tolist()}
+    return Report(rows, document)
 
 
 def _value_rows(values, table, notes=None):

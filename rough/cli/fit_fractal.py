@@ -11,17 +11,17 @@ from .options import (
     RegistryChoice,
     crop_option,
     gaps_option,
-    jobs_option,
     model_options,
     plot_option,
     report_format,
-    surface_input,
+    tiled_input,
 )
 from .report import Report, on_stdout, shown
+from .work_options import jobs_option
 
 
 @click.command("fit-fractal", short_help="Fractal dimension D and amplitude coefficient C, with uncertainty.")
-@surface_input
+@tiled_input
 @jobs_option
 @crop_option
 @click.option(
@@ -93,6 +93,7 @@ def fit_fractal(
     tip_radius,
     psd_file,
     plot,
+    work,
 ):
     """Fit the power law of INPUT's power spectrum (default: standard input): the
     fractal dimension D (a profile's, 1-2; a map's surface dimension Ds, 2-3, with
@@ -126,10 +127,13 @@ def fit_fractal(
         rough fit-fractal --band 0.05/mm:5/mm --resolution 0.0309mm --psd psd.tsv --plot psd.png scan.x3p
     """
     report = not on_stdout(psd=psd_file, plot=plot)
-    if fill:
-        surface = fractal.fill_invalid(surface)
     model = {"band": band, "resolution": resolution, "sampling": sampling, "noise": noise, "rolloff": rolloff}
     model.update(level=level, order=order, tip_radius=tip_radius)
+    if isinstance(surface, io.TiledSurface):
+        options = dict(gaps=gaps, estimator=estimator, fill=fill, tip_radius=tip_radius, psd_file=psd_file, plot=plot)
+        return _tiled_report(surface, input, direction, options, report, work, **model)
+    if fill:
+        surface = fractal.fill_invalid(surface)
     if estimator or direction is not None:
         if estimator and (psd_file or plot):
             raise InputError("--psd and --plot draw a spectrum and its fit: leave out --estimator")
@@ -150,6 +154,40 @@ def fit_fractal(
     elif plot:
         _plot_spectrum(plot, spectrum, result, surface.spacing, _title(input, surface))
     return Report(_rows(result, surface.is_profile, document), document) if report else None
+
+
+def _tiled_report(surface, input, direction, options, report, work, tip_radius, **model):
+    """The fit of a map read in tiles (:mod:`rough.fractal.tiled`): the 2-D spectrum's,
+    a stated estimator, or the profiles', exact; the options tiles cannot honour are refused."""
+    refused = {"estimator": "--estimator", "tip_radius": "--tip-radius"}
+    if direction is not None:
+        refused.update(fill="--fill with --profiles (--gaps fill fills each profile)", psd_file="--psd with --profiles")
+        refused.update(plot="--plot with --profiles")
+    for name, flag in refused.items():
+        if options[name]:
+            raise InputError(f"{flag} is not available for a map read in tiles (raise --memory to read it whole)")
+    if direction is not None:
+        result = fractal.fit_profiles_tiles(surface, direction, options["gaps"], **model, **work)
+        document = {**result.as_dict(), "tiled": result.tiled}
+        rows = _rows(result.fit, True, document) + _profile_rows(result)
+        return Report(rows + [_tiled_row(result.tiled)], document) if report else None
+    wanted = bool(options["psd_file"] or options["plot"])
+    result = fractal.fit_fractal_tiles(surface, fill=options["fill"], spectrum=wanted, **model, **work)
+    document = {**result.as_dict(), "points": surface.point_count}
+    if options["psd_file"]:
+        _write_psd(options["psd_file"], result.spectrum, "ring-averaged P2, tiles' Welch average + coarse level", "m4")
+    if options["plot"]:
+        if result.verdict == "no power-law range":
+            raise InputError("--plot: no power-law range, and the roughness against scale is not measured on tiles")
+        _plot_spectrum(options["plot"], result.spectrum, result, surface.spacing, _title(input, surface))
+    return Report(_rows(result, False, document) + [_tiled_row(result.tiled)], document) if report else None
+
+
+def _tiled_row(tiled):
+    estimated = "; ".join(f"{name}: {how}" for name, how in tiled["estimated"].items())
+    exact = ", ".join(tiled["exact"]) or "nothing"
+    units = {"join": "1/m"} if "join" in tiled else ""
+    return ("tiled", tiled, units, f"read in tiles: exact: {exact}; estimated: {estimated or 'nothing'}")
 
 
 def _profiles_report(surface, input, direction, gaps, model, psd_file, plot, report):

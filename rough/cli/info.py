@@ -3,15 +3,16 @@
 import click
 
 from .. import io, metrology, units
-from .options import jobs_option, report_format, surface_input
+from .options import report_format, tiled_input
 from .report import Report
+from .work_options import jobs_option
 
 
 @click.command(short_help="Shape, spacing, size, valid points, z range, Rq/Sq and history.")
-@surface_input
+@tiled_input
 @jobs_option
 @report_format
-def info(surface, input):
+def info(surface, input, work):
     """Describe the surface in INPUT (default: standard input).
 
     Reports the number of points and spacing (x first), the physical size, the
@@ -26,7 +27,7 @@ def info(surface, input):
         rough info --json scan.x3p | jq .spacing
         rough info --tsv a.x3p b.x3p c.x3p > inventory.tsv
     """
-    facts = metrology.summary(surface)
+    facts = metrology.summary(surface, **work)
     document = {"format": surface.source_format, **facts}
     x_by_y = " × ".join
     rms_key = "Rq" if surface.is_profile else "Sq"
@@ -54,6 +55,9 @@ def info(surface, input):
         (rms_key, facts[rms_key], "m", f"{_length(facts[rms_key])} (valid points about their mean, not levelled)"),
         ("units", facts["units"], "", f"in the file: xy {surface.units.xy}, z {surface.units.z}"),
     ]
+    if isinstance(surface, io.TiledSurface):
+        rows.append(("tiled", True, "", "read a strip at a time: larger than the memory budget (--memory)"))
+        document["tiled"] = True
     rows += [(f"metadata.{key}", value, "", value) for key, value in sorted(facts["metadata"].items())]
     rows += [(f"history.{number}", entry, "", _history_line(entry)) for number, entry in enumerate(facts["history"])]
     return Report(rows, document)

@@ -6,8 +6,9 @@ import click
 
 from .. import metrology
 from ..units import format_length, format_quantity
-from .options import LENGTH, crop_option, report_format, surface_input
+from .options import LENGTH, crop_option, report_format, split_input
 from .report import Report
+from .work_options import jobs_option
 
 
 class SizeType(click.ParamType):
@@ -53,7 +54,8 @@ def _one_output(command):
 
 @click.command(short_help="Roughness maps: parameters and fractal fits per window, as a multi-band GeoTIFF.")
 @_one_output
-@surface_input
+@split_input
+@jobs_option
 @crop_option
 @click.option(
     "--window",
@@ -83,7 +85,7 @@ def _one_output(command):
     "format rough writes (.x3p, .npy …). Without it, print a summary.",
 )
 @report_format
-def map_command(surface, input, window, step, parameters, order, target):
+def map_command(surface, input, window, step, parameters, order, target, work):
     """Compute areal parameters, the fractal fit (hurst, dimension, amplitude) and the
     lay in windows of the map INPUT moved by --step, each window levelled by its own
     least-squares polynomial of degree --order, and write them with -o as a
@@ -94,16 +96,22 @@ def map_command(surface, input, window, step, parameters, order, target):
     invalid points. Without -o, prints each parameter's minimum, median and maximum
     over the windows.
 
+    A map too large for --memory is read a band of windows at a time, with the same
+    results. --jobs works on several bands at once, --scheduler on a Dask cluster's
+    workers (which must reach INPUT); the map is written here.
+
     \b
     Examples:
         rough map dem.tif --window 256px --parameters Sq,Ssk,hurst -o roughness.tif
         rough map dem.tif --window 50m --step 25m --parameters Sq,lay
         rough map scan.x3p --window 64px --parameters Sq -o sq.x3p
+        rough map big.tif --window 256px --parameters Sq,hurst --jobs auto -o big_map.tif
+        rough map big.tif --window 256px --scheduler tcp://head:8786 -o big_map.tif
     """
     names = [name.strip() for name in parameters.split(",") if name.strip()]
     if target:
         metrology.RoughnessMap.output_format(target, names)
-    result = metrology.roughness_map(surface, window, step=step, parameters=names, order=order)
+    result = metrology.roughness_map(surface, window, step=step, parameters=names, order=order, **work)
     if target:
         result.write(target)
         return None
@@ -130,4 +138,9 @@ def _report(result):
         if undefined:
             why = "; ".join(f"{count}: {reason}" for reason, count in summary["reasons"].items())
             rows.append((f"parameters.{name}.undefined", undefined, "1", f"{undefined} windows NaN ({why})"))
+    if "tiled" in document:
+        tiled = document["tiled"]
+        bands = "1 band" if tiled["tiles"] == 1 else f"{tiled['tiles']} bands"
+        text = f"read in {bands} of up to {tiled['tile_rows']} rows; every window computed whole (exact)"
+        rows.append(("tiled.tiles", tiled["tiles"], "1", text))
     return Report(rows, document)

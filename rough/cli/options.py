@@ -1,16 +1,16 @@
 """Options shared by the subcommands, as decorators (in the manner of rasterio's rio).
 
 ``surface_input`` adds INPUT… (default ``-``) and the read options and calls the
-command once per input with a :class:`~rough.Surface` (``input_options(flag)`` names
-the input-spacing option otherwise, for commands whose own ``--spacing`` is an
-output); ``surface_output`` adds ``-o/--output`` and ``-f/--format`` and hands it an
-:class:`Output` that writes a surface there; ``report_format`` adds
-``--json``/``--tsv``; ``renamed`` keeps an option's old name working for a release.
+command once per input with a :class:`~rough.Surface`; ``surface_output`` adds
+``-o/--output`` and ``-f/--format`` and hands it an :class:`Output` that writes a
+surface there; ``report_format`` adds ``--json``/``--tsv``. A command made with
+``cls=Command`` answers an option spelling that rough 0.14 removed (:data:`RENAMED`)
+with a usage error that names the new one.
 
 Lengths, frequencies and physical quantities name their unit (``0.1545mm``,
-``0.2/mm``, ``20mm/s``); zero needs none. rough 0.12 still reads a bare number in the
-option's old default unit (mm, per mm, the quantity's), with a one-line warning
-(:func:`bare_number`); rough 0.14 refuses it.
+``0.2/mm``, ``20mm/s``); zero needs none. rough 0.12 and 0.13 read a bare number in
+the option's old default unit (mm, per mm, the quantity's), with a warning; since
+rough 0.14 it is refused, in one line that shows the unit (:func:`bare_number`).
 
 Every number an option takes is range-checked here, by its type: it must be finite
 (NaN and infinities refused), positive where the option says so, and of a plausible
@@ -32,11 +32,13 @@ from click.shell_completion import CompletionItem
 
 from .. import errors, extras, fractal, io, metrology, units
 from ..io import registry
+from . import work_options
 from .batch import check_inputs, read_named, run_each, stem_name
 
 log = logging.getLogger("rough")
-#: The release that refuses what 0.12 still takes with a warning.
-REFUSED_FROM = "0.14"
+#: The last release that read a bare number in the option's old unit (with a warning);
+#: rough 0.14 refuses it.
+READ_UNTIL = "0.13"
 
 #: The smallest and largest length (metres) an option takes: 1 pm (below an atom's
 #: size) and 10 000 km (a planet's elevation model, a UTM northing); zero where an
@@ -72,13 +74,16 @@ def _length(metres):
 
 
 def bare_number(value, flag, unit):
-    """Warn, once per option ``flag``, that ``value`` is a bare number read in the
-    option's old default ``unit`` (rough 0.12; zero needs no unit)."""
-    if flag is not None and flag not in _warned and units.is_bare(value) and float(value) != 0:
-        _warned.add(flag)
-        log.warning(
-            f"{flag} {value.strip()}: a bare number is read as {value.strip()} {unit}; write the unit "
-            f"(bare numbers are refused from rough {REFUSED_FROM})"
+    """Refuse ``value`` if it is a number that names no unit (zero needs none): rough
+    0.12 and 0.13 read it in the option ``flag``'s old default ``unit`` (``mm``,
+    ``/mm``, ``mm/s`` …), with a warning; since 0.14 it is a one-line usage error (exit
+    status 2) that shows the unit to write."""
+    if units.is_bare(value) and float(value) != 0:
+        number = str(value).strip()
+        said = f"per {unit[1:]}" if unit.startswith("/") else unit
+        raise click.UsageError(
+            f"{f'{flag} ' if flag else ''}{number}: give a unit, e.g. {number}{unit} "
+            f"(bare numbers were read as {said} until rough {READ_UNTIL})"
         )
 
 
@@ -87,38 +92,39 @@ def _flag(param):
     return param.opts[-1] if param is not None and param.opts else None
 
 
-_warned = set()
+#: Option spellings that rough 0.12 renamed and 0.14 removed, and resample's
+#: ``--input-spacing``, which 0.14 made ``--spacing`` as on every other command:
+#: (command, old spelling) → (new spelling, the release that renamed it).
+RENAMED = {
+    ("synth", "--spacing"): ("--step", "0.12"),
+    ("synth", "--rolloff"): ("--rolloff-wavelength", "0.12"),
+    ("resample", "--input-spacing"): ("--spacing", "0.14"),
+    ("experiment design", "--spacing"): ("--step", "0.12"),
+    ("experiment design", "--synthesis-spacing"): ("--synthesis-step", "0.12"),
+    ("rose", "--step"): ("--angle-step", "0.12"),
+    ("show", "-o"): ("--plot", "0.12"),
+    ("show", "--output"): ("--plot", "0.12"),
+}
 
 
-def renamed(old, new, name, type=None, required=False):
-    """A hidden alias ``old`` (a flag, or a tuple of them) of the option ``new``, whose
-    keyword is ``name``: it works until rough 0.14, with a one-line warning. With
-    ``required``, one of the two must be given (put it above ``input_options``, so that
-    this is checked before any input is read)."""
-    old = (old,) if isinstance(old, str) else old
+class Command(click.Command):
+    """A click command that answers an old spelling of :data:`RENAMED` with one usage
+    line naming the new one (``--spacing was renamed --step in rough 0.12``) instead of
+    click's bare "No such option" (``@click.command(cls=Command)``)."""
 
-    def warn(ctx, param, value):
-        if value is not None:
-            log.warning(f"{'/'.join(old)} is deprecated (rough 0.12): use {new}; it goes in {REFUSED_FROM}")
-        return value
-
-    def decorate(command):
-        @functools.wraps(command)
-        def wrapper(*args, **kwargs):
-            value = kwargs.pop(f"deprecated_{name}")
-            if value is not None:
-                if click.get_current_context().get_parameter_source(name) == click.core.ParameterSource.COMMANDLINE:
-                    raise click.UsageError(f"give {new}, not {'/'.join(old)} too")
-                kwargs[name] = value
-            elif required and kwargs.get(name) is None:
-                context = click.get_current_context()
-                option = next(param for param in context.command.params if param.name == name)
-                raise click.MissingParameter(ctx=context, param=option)
-            return command(*args, **kwargs)
-
-        return click.option(*old, f"deprecated_{name}", type=type, hidden=True, callback=warn)(wrapper)
-
-    return decorate
+    def parse_args(self, ctx, args):
+        try:
+            return super().parse_args(ctx, args)
+        except click.NoSuchOption as error:
+            names, context = [], ctx
+            while context.parent is not None:  # the command's path below ``rough``
+                names.insert(0, context.info_name)
+                context = context.parent
+            new = RENAMED.get((" ".join(names) or ctx.info_name, error.option_name))
+            if new is None:
+                raise
+            message = f"{error.option_name} was renamed {new[0]} in rough {new[1]}"
+            raise click.NoSuchOption(error.option_name, message, ctx=ctx) from None
 
 
 class FloatRange(click.FloatRange):
@@ -152,13 +158,12 @@ class LengthType(click.ParamType):
     def convert(self, value, param, ctx):
         if isinstance(value, float):
             return value
+        bare_number(value, _flag(param), "mm")
         try:
-            length = units.parse_length(value, "mm")
+            length = units.parse_length(value)
         except errors.InputError as error:
             self.fail(str(error), param, ctx)
-        length = self.checked(length, value, param, ctx)
-        bare_number(value, _flag(param), "mm")  # after the checks: a refused value is one line
-        return length
+        return self.checked(length, value, param, ctx)
 
     def checked(self, length, value, param, ctx):
         """``length`` if it is in this type's range; a failure otherwise."""
@@ -196,8 +201,9 @@ class SpacingType(PositiveLengthType):
 
 class QuantityType(click.ParamType):
     """A physical quantity with a unit (``1.28N/mm``, ``20mm/s``, ``1.85g``) → SI; a
-    bare number is in ``default_unit``, with a warning (rough 0.12). Zero (unless ``positive``) or a magnitude within
-    :data:`QUANTITIES` for its kind (and at most ``most``, if given)."""
+    bare number is refused (until rough 0.13 it was in ``default_unit``). Zero (unless
+    ``positive``) or a magnitude within :data:`QUANTITIES` for its kind (and at most
+    ``most``, if given)."""
 
     def __init__(self, kind, default_unit, positive=False, most=None):
         self.kind, self.default_unit, self.positive = kind, default_unit, positive
@@ -207,16 +213,15 @@ class QuantityType(click.ParamType):
     def convert(self, value, param, ctx):
         if isinstance(value, float):
             return value
+        bare_number(value, _flag(param), self.default_unit)
         try:
-            quantity = units.parse_quantity(value, self.kind, self.default_unit)
+            quantity = units.parse_quantity(value, self.kind)
         except errors.InputError as error:
             self.fail(str(error), param, ctx)
         if quantity < 0:
             self.fail(f"{value!r}: must not be negative", param, ctx)
         what = f"a {self.kind}"
-        quantity = _refuse_outside(self, quantity, self.bounds, value, param, ctx, what, self.show, not self.positive)
-        bare_number(value, _flag(param), self.default_unit.replace("*", "·"))
-        return quantity
+        return _refuse_outside(self, quantity, self.bounds, value, param, ctx, what, self.show, not self.positive)
 
     def show(self, quantity):
         """``quantity`` (SI) in this option's unit."""
@@ -291,7 +296,8 @@ class CropType(click.ParamType):
 
 class FrequencyRangeType(click.ParamType):
     """``FMIN:FMAX`` spatial frequencies (``0.1/mm:20/mm``; an empty end is open) →
-    (fmin or None, fmax or None) in 1/m. A bare number is per mm, with a warning (rough 0.12)."""
+    (fmin or None, fmax or None) in 1/m. A bare number is refused (until rough 0.13 it
+    was per mm)."""
 
     name = "FMIN:FMAX"
 
@@ -301,8 +307,10 @@ class FrequencyRangeType(click.ParamType):
         ends = str(value).split(":")
         if len(ends) != 2:
             self.fail(f"{value!r}: write a band as FMIN:FMAX, e.g. 0.1/mm:20/mm", param, ctx)
+        for end in ends:
+            bare_number(end, _flag(param), "/mm")
         try:
-            low, high = (None if not end.strip() else units.parse_frequency(end, "mm") for end in ends)
+            low, high = (None if not end.strip() else units.parse_frequency(end) for end in ends)
         except errors.InputError as error:
             self.fail(str(error), param, ctx)
         if any(end is not None and end <= 0 for end in (low, high)):
@@ -313,8 +321,6 @@ class FrequencyRangeType(click.ParamType):
                 _refuse_outside(self, end, bounds, value, param, ctx, "a frequency", lambda f: f"{f * 1e-3:.6g}/mm")
         if low is not None and high is not None and low >= high:
             self.fail(f"{value!r}: FMIN must be below FMAX, e.g. 0.05/mm:5/mm", param, ctx)
-        for end in ends:
-            bare_number(end, _flag(param), "/mm")
         return low, high
 
 
@@ -434,13 +440,18 @@ class RegridType(SpacingType):
         return LengthType.convert(self, length, param, ctx), method
 
 
-def input_options(spacing_flag="--spacing", together=None):
+def input_options(spacing_flag="--spacing", together=None, tiles=False, split=False):
     """INPUT… plus ``--spacing`` (under ``spacing_flag``), ``--unit``,
     ``--ignore-checksums``, ``--channel``, ``--layer`` and ``--regrid``. The command
     is called once per input with ``surface`` (the surface read) and ``input`` (the
     name given), and returns a :class:`~rough.cli.report.Report` or None (see
     :mod:`rough.cli.batch`). With ``together`` = N it takes up to N inputs at once
-    instead, as the lists ``surfaces`` and ``inputs``."""
+    instead, as the lists ``surfaces`` and ``inputs``. With ``tiles`` the command also
+    takes ``--memory`` and is given a :class:`~rough.io.TiledSurface` for a map too
+    large for that budget (:func:`rough.io.open_surface`), and ``work``: the keywords
+    ``budget``, ``jobs`` and ``scheduler`` of the library's tiled functions. With
+    ``split`` (a command that cuts any map into pieces: ``map``) one input's pieces go
+    to ``--scheduler``'s cluster too, not the input whole."""
 
     def decorate(command):
         @functools.wraps(command)
@@ -454,9 +465,12 @@ def input_options(spacing_flag="--spacing", together=None):
                 crop=kwargs.pop("crop", None),
                 regrid=regrid,
             )
+            names = list(input or ("-",))
+            if tiles:
+                options["memory"] = kwargs.pop("memory")
+                kwargs["work"] = _pieces_work(options["memory"], names, kwargs, split)
             if "output" in kwargs:  # surface_output's, made an Output here to name one per input
                 kwargs["output"] = Output(kwargs.pop("output"), kwargs.pop("format"))
-            names = list(input or ("-",))
             if together:
                 return _together(functools.partial(command, *args), names, options, together, kwargs)
 
@@ -498,6 +512,15 @@ def input_options(spacing_flag="--spacing", together=None):
                 "Without it they are refused.",
             ),
         ]
+        if tiles:
+            decorators.append(
+                click.option(
+                    "--memory",
+                    type=work_options.MemoryType(),
+                    help="Memory budget, e.g. 4GB: a map that would need more is read in tiles "
+                    "(default: half the machine's memory, or ROUGH_MEMORY).",
+                )
+            )
         for decorator in reversed(decorators):
             wrapper = decorator(wrapper)
         return wrapper
@@ -519,6 +542,23 @@ def _together(command, names, options, most, kwargs):
 
 
 surface_input = input_options()
+#: The input of commands that work on a map larger than memory, a tile at a time.
+tiled_input = input_options(tiles=True)
+#: The input of ``map``, which cuts any map into bands of windows: one input's bands go to
+#: ``--jobs`` and ``--scheduler``.
+split_input = input_options(tiles=True, split=True)
+
+
+def _pieces_work(budget, names, kwargs, split):
+    """``--jobs`` goes to the inputs when there are several, and to the pieces (tiles,
+    strips, bands of windows) of the one input otherwise. ``--scheduler`` sends the
+    inputs to the cluster (each worker then works on its input's pieces in turn), or,
+    with ``split`` and one input, that input's pieces."""
+    if len(names) > 1 or "jobs" not in kwargs:
+        return {"budget": budget, "jobs": 1, "scheduler": None}
+    work = {"budget": budget, "jobs": kwargs["jobs"], "scheduler": kwargs["scheduler"] if split else None}
+    kwargs.update(jobs=1, scheduler=None if split else kwargs["scheduler"])
+    return work
 
 
 class RegistryChoice(click.Choice):
@@ -628,40 +668,6 @@ class Output:
             return
         with io.atomic_output("-") as stream:
             io.write(surface, stream, format=self.format)
-
-
-class JobsType(click.ParamType):
-    """``--jobs``: a number of processes from 0 to :data:`MOST_JOBS`, or ``auto`` (0):
-    one per core this process may use."""
-
-    name = "N|auto"
-
-    def convert(self, value, param, ctx):
-        if isinstance(value, int):
-            return value
-        text = str(value).strip().lower()
-        if text == "auto":
-            return 0
-        if not text.isdigit() or int(text) > MOST_JOBS:
-            self.fail(f"{value!r}: give a number of processes from 0 to {MOST_JOBS}, or auto", param, ctx)
-        return int(text)
-
-
-#: The most processes ``--jobs`` starts.
-MOST_JOBS = 256
-
-
-def jobs_option(command):
-    """``--jobs N``: with several inputs, N worker processes (0 or ``auto``: the cores);
-    run_each (:mod:`rough.cli.batch`) takes it."""
-    return click.option(
-        "--jobs",
-        type=JobsType(),
-        default=1,
-        show_default=True,
-        help="With several inputs, work on N at once, each in its own process (0 or auto: one per core); "
-        "the output is the same, in input order.",
-    )(command)
 
 
 def report_format(command):

@@ -3,14 +3,14 @@
 import click
 
 from .. import fractal
-from .options import SPACING, input_options, jobs_option, renamed, surface_output
+from .options import SPACING, Command, surface_input, surface_output
+from .work_options import jobs_option
 
 
-@click.command(short_help="Resample to a new spacing without aliasing.")
-@renamed("--spacing", "--step", "step", SPACING, required=True)  # outside input_options: checked before reading
-@input_options("--input-spacing")
+@click.command(cls=Command, short_help="Resample to a new spacing without aliasing.")
+@surface_input
 @jobs_option
-@click.option("--step", type=SPACING, help="The new spacing (required), e.g. 0.1545mm (or DX,DY for maps).")
+@click.option("--step", type=SPACING, required=True, help="The new spacing, e.g. 0.1545mm (or DX,DY for maps).")
 @click.option("--fill", is_flag=True, help="Fill invalid points first (they are NaN again in the result).")
 @surface_output
 def resample(surface, input, step, fill, output):
@@ -19,7 +19,8 @@ def resample(surface, input, step, fill, output):
     spacing cannot hold instead of folding them back; refining interpolates without
     adding roughness above the old Nyquist frequency. The fractal D and C in the
     remaining band are kept (fit them below ~80 % of the new Nyquist frequency).
-    --input-spacing gives the spacing of input data that carry none.
+    --spacing gives the spacing of input data that carry none, as on every command
+    (until rough 0.14 it was --input-spacing here).
 
     \b
     Examples:

@@ -9,21 +9,23 @@ from ..units import format_length, format_quantity
 from .options import (
     BAND,
     LENGTH,
+    Command,
     FloatRange,
     RegistryChoice,
     crop_option,
     gaps_option,
-    jobs_option,
     model_options,
     plot_option,
-    renamed,
     report_format,
     surface_input,
 )
 from .report import Report, on_stdout, shown
+from .work_options import jobs_option
 
 
-@click.command(short_help="D(θ) and C(θ) by direction for maps (the amplitude coefficient rose); Str, Std.")
+@click.command(
+    cls=Command, short_help="D(θ) and C(θ) by direction for maps (the amplitude coefficient rose); Str, Std."
+)
 @surface_input
 @jobs_option
 @crop_option
@@ -34,7 +36,6 @@ from .report import Report, on_stdout, shown
     show_default=True,
     help="Angle between sector centres (degrees; must divide 180).",
 )
-@renamed("--step", "--angle-step", "angle_step", FloatRange(1, 90))
 @click.option(
     "--width",
     type=FloatRange(1, 180),

@@ -5,8 +5,9 @@ import os
 import click
 
 from .. import extras, metrology, plots
-from .options import crop_option, jobs_option, renamed, surface_input
+from .options import Command, crop_option, surface_input
 from .report import shown
+from .work_options import jobs_option
 
 FORMATS = ("png", "svg", "pdf")
 
@@ -35,8 +36,9 @@ def _format(output, format):
     return extension
 
 
-@click.command(short_help="Draw a profile or map: height colour map (or hill shade) with units, scale bar and NaN.")
-@renamed(("-o", "--output"), "--plot", "plot")  # outside surface_input: it names one figure per input
+@click.command(
+    cls=Command, short_help="Draw a profile or map: height colour map (or hill shade) with units, scale bar and NaN."
+)
 @surface_input
 @jobs_option
 @crop_option

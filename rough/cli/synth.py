@@ -5,7 +5,7 @@ import math
 import click
 
 from .. import errors, fractal, units
-from .options import LENGTH, FloatRange, renamed, surface_output
+from .options import LENGTH, Command, FloatRange, surface_output
 
 
 class SizeType(click.ParamType):
@@ -42,7 +42,7 @@ SURFACE_DIMENSION = FloatRange(2, 3, min_open=True, max_open=True)
 ANGLE = FloatRange(-360, 360)
 
 
-@click.command(short_help="Synthesise a fractal profile or map with chosen D and C or Rq.")
+@click.command(cls=Command, short_help="Synthesise a fractal profile or map with chosen D and C or Rq.")
 @click.option("--length", type=LENGTH, help="Profile length, e.g. 80mm (a profile; or give --points).")
 @click.option("--points", type=click.IntRange(2, None), help="Profile length in points.")
 @click.option("--size", type=SizeType(), help="Map size in points, NXxNY (a map).")
@@ -53,7 +53,6 @@ ANGLE = FloatRange(-360, 360)
     show_default=True,
     help="Sampling interval of the surface made (the default is the paper's encoder resolution).",
 )
-@renamed("--spacing", "--step", "step", LENGTH)
 @click.option(
     "--dimension",
     type=FloatRange(1, 3, min_open=True, max_open=True),
@@ -86,7 +85,6 @@ ANGLE = FloatRange(-360, 360)
     type=LENGTH,
     help="Wavelength beyond which the spectrum is flat: self-affine only below it (rock is, over finite scales).",
 )
-@renamed("--rolloff", "--rolloff-wavelength", "rolloff_wavelength", LENGTH)
 @click.option(
     "--fragments",
     type=click.IntRange(4, None),

@@ -32,3 +32,7 @@ from .sectors import rose as rose
 from .synth import synthesize_fragments as synthesize_fragments
 from .synth import synthesize_profile as synthesize_profile
 from .synth_map import synthesize_map as synthesize_map
+from .tiled import TiledFractalFit as TiledFractalFit
+from .tiled import fit_fractal_tiles as fit_fractal_tiles
+from .tiled_profiles import TiledProfileFit as TiledProfileFit
+from .tiled_profiles import fit_profiles_tiles as fit_profiles_tiles

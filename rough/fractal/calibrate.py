@@ -26,6 +26,7 @@ import math
 import numpy as np
 import scipy.fft
 
+from ..compiled import one_blas_thread
 from ..errors import InputError
 from . import estimators as est
 from .jackknife import jackknife_variance, neighbour_blocks
@@ -201,6 +202,7 @@ class Design:
         return est.Padded(rows, all_lengths)
 
 
+@one_blas_thread
 def _estimate(name, profiles, spacing, scales, noisy, sampling="point"):
     """The raw estimate of ``name``; the Whittle fit gets a noise floor only for ``noisy``
     data, and the sampling model given."""
@@ -209,6 +211,7 @@ def _estimate(name, profiles, spacing, scales, noisy, sampling="point"):
     return est.ESTIMATORS[name](profiles, spacing, scales)
 
 
+@one_blas_thread
 def _raw_values(name, padded, groups, design):
     """Raw Ĥ of each group of rows (a replicate) of the synthetic ``padded``."""
     if name == "whittle":

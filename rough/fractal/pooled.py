@@ -24,15 +24,19 @@ def periodograms(heights, spacing):
 
 def pooled(periodograms, spacing, band, sampling, effect=1.0):
     """:class:`~rough.fractal.scaling.Bins` of the periodograms' ordinates in ``band``
-    (``low ≤ f ≤ high``), one bin per distinct frequency holding the mean of its
+    (``low ≤ f ≤ high``; each periodogram ``(f, I)``, or ``(f, ΣI, n)``: n ordinates at
+    f summing to ΣI), one bin per distinct frequency holding the mean of its
     ordinates (the Whittle likelihood of equal-frequency ordinates is that of their
     mean with their count as weight), the weight divided by the design ``effect``;
     None with fewer than MIN_ORDINATES frequencies."""
     low, high = band
-    frequencies = np.concatenate([f for f, _ in periodograms])
-    ordinates = np.concatenate([values for _, values in periodograms])
+    frequencies = np.concatenate([f for f, *_ in periodograms])
+    ordinates = np.concatenate([values for _, values, *_ in periodograms])
     keep = (frequencies >= low) & (frequencies <= high)
     distinct, inverse, count = np.unique(frequencies[keep], return_inverse=True, return_counts=True)
+    if any(len(periodogram) > 2 for periodogram in periodograms):  # sums of several ordinates, with their counts
+        counts = np.concatenate([(*rest, np.ones(f.size, np.int64))[0] for f, _, *rest in periodograms])
+        count = np.bincount(inverse, weights=counts[keep]).astype(np.int64)
     if distinct.size < MIN_ORDINATES:
         return None
     bins = profile_bins(distinct, spacing, np.bincount(inverse, weights=ordinates[keep]) / count, sampling)

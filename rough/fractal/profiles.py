@@ -200,31 +200,46 @@ def fit_profiles(
     cutoff = _cutoff(profiles, tip_radius)
     limits = _limits(profiles, given, band, cutoff)
     spectra = periodograms(profiles.heights, profiles.spacing)
+    blocks = neighbour_blocks(profiles.positions)
+    options = Options(noise, rolloff, level)
+    return pooled_fit(
+        profiles, spectra, blocks, (limits, band), (sampling, source), resolution, options, spread, cutoff
+    )
+
+
+def pooled_fit(profiles, spectra, blocks, bands, sampling, resolution, options, spread=True, cutoff=None):
+    """The pooled fit of the profiles' periodograms ``spectra`` (see
+    :func:`~rough.fractal.pooled.pooled`; one per profile, or the sums of a block's in
+    its first and nothing in the others) with the jackknife over ``blocks`` (indices
+    into ``spectra``): a :class:`ProfileFit`. ``profiles`` is the :class:`ProfileSet`,
+    or what stands for one (its ``spacing``, ``label``, ``angle``, ``interpolation``,
+    ``gaps``, ``points``; ``heights`` None: no scale table without a power law);
+    ``bands`` is ``(limits, band)``: the frequencies allowed and the band asked for."""
+    (limits, band), (sampling, source) = bands, sampling
     if pooled(spectra, profiles.spacing, limits, sampling) is None:
         raise InputError("fewer than 8 frequencies in the fit band; widen --band or use longer profiles")
-    blocks = neighbour_blocks(profiles.positions)
     effect = design_effect(spectra, blocks, profiles.spacing, limits, sampling)
     bins = pooled(spectra, profiles.spacing, limits, sampling, effect)
-    options = Options(noise, rolloff, level)
     outcome = band_outcome(bins, BETA_RANGE, band, options)
     count = int(outcome.fit.bins.count.sum()) if outcome.fit else int(bins.count.sum())
-    method = f"whittle (pooled periodograms of {len(profiles.heights)} profiles)"
+    method = f"whittle (pooled periodograms of {len(spectra)} profiles)"
     settings = Settings(method, "none (first differences)", sampling, source, 0.0, count)
     fit = from_outcome(outcome, "profile", resolution, settings)
     errors = uncertainty(profiles, spectra, blocks, outcome, fit, sampling, options, spread)
+    table = fit.verdict == "no power-law range" and profiles.heights is not None
     fit = dataclasses.replace(
         fit,
         fractal_dimension_stderr=errors["hurst"],
         amplitude_coefficient_stderr=errors["amplitude"],
         reliability_cutoff=cutoff,
-        scale_dependent=_by_scale(profiles, cutoff) if fit.verdict == "no power-law range" else None,
+        scale_dependent=_by_scale(profiles, cutoff) if table else None,
     )
-    announce(fit, level)
+    announce(fit, options.level)
     return ProfileFit(
         fit=fit,
         direction=profiles.label,
         angle=math.degrees(profiles.angle) % 180 if math.isfinite(profiles.angle) else math.nan,
-        profiles=len(profiles.heights),
+        profiles=len(spectra),
         points=profiles.points,
         hurst_stderr=errors["hurst"],
         hurst_spread=errors["spread"],

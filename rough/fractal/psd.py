@@ -220,6 +220,12 @@ def binned_spectrum(surface, order=1, per_decade=10):
     step = max(1 / (nx * surface.spacing[0]), 1 / (ny * surface.spacing[1]))
     field, power = windowed_map(surface, order)
     rings = ring_spectrum(field, power, surface.spacing, step, min(0.5 / d for d in surface.spacing), step)
+    return binned_rings(rings, per_decade)
+
+
+def binned_rings(rings, per_decade=10):
+    """A ring spectrum (see :func:`ring_spectrum`) in ``per_decade`` logarithmic bins:
+    ``{"frequency", "density", "count"}`` (lists; 1/m, m⁴, ordinates)."""
     frequencies = np.exp(rings["log_radius"])
     groups = np.floor(np.log10(frequencies) * per_decade + 1e-9).astype(int)
     result = {"frequency": [], "density": [], "count": []}

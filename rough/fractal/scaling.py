@@ -39,6 +39,8 @@ import numpy as np
 from scipy.optimize import minimize, minimize_scalar
 from scipy.special import chdtrc, gammainc, gammaincc, ndtri, zeta  # scipy.stats' own, without its import time
 
+from ..compiled import one_blas_thread
+
 GOF_PER_DECADE = 10
 NOISE_LOG_RATIO = (-15.0, 15.0)
 POWER_TEST = 13.82  # the 0.1 % point of χ²₂: a floor-only spectrum against floor plus power law
@@ -263,6 +265,7 @@ def gof_p_value(bins, expected, parameters, per_decade=GOF_PER_DECADE):
     return float(chdtrc(freedom, np.sum(np.minimum(z**2, 1e6))))
 
 
+@one_blas_thread
 def fit_spectrum(bins, exponent_range, noise=True, rolloff=False):
     """The maximum-likelihood fit of the model to ``bins``: a :class:`SpectralFit`.
 

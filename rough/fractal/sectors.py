@@ -28,6 +28,7 @@ import numpy as np
 from scipy import fft
 from scipy.special import chdtrc  # χ²'s survival function, without importing scipy.stats
 
+from ..compiled import one_blas_thread
 from ..errors import InputError
 from ..metrology import detrend
 from ..metrology.spatial import autocorrelation_lengths, texture_direction
@@ -185,6 +186,7 @@ class Rose:
         }
 
 
+@one_blas_thread
 def rose(
     surface,
     step=10.0,

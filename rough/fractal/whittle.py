@@ -9,6 +9,7 @@ import math
 
 import numpy as np
 
+from ..compiled import one_blas_thread
 from ..errors import InputError
 from .choices import SAMPLINGS
 from .psd import ring_spectrum, windowed_map
@@ -65,6 +66,7 @@ def history_sampling(surface):
     return "band-limited" if made & {"synth", "resample"} else None
 
 
+@one_blas_thread
 def band_outcome(bins, exponent_range, band, options):
     """The fit over ``band`` when both its ends are given, else over the scaling range
     found inside ``bins`` (see :mod:`rough.fractal.scaling`)."""
@@ -86,6 +88,7 @@ def difference_periodogram(heights, spacing):
     return k / (m * spacing), spacing / m * np.abs(transform[k]) ** 2
 
 
+@one_blas_thread
 def whittle_profile(heights, surface, band, resolution, sampling, options):
     """The Whittle fit of a levelled profile's ``heights`` over ``band`` (its scaling
     range when an end is open), ``sampling`` a pair (model, where it came from; None:
@@ -120,6 +123,7 @@ def whittle_profile(heights, surface, band, resolution, sampling, options):
     )
 
 
+@one_blas_thread
 def _likelier(outcomes, spacing, options):
     """``(sampling, outcome, spread)``: of the samplings' outcomes, the one with the
     better verdict and the wider band; over its band both sampling models are then
@@ -192,6 +196,7 @@ def map_band(surface, band, sampling):
     return step, low, high
 
 
+@one_blas_thread
 def whittle_map(surface, order, band, resolution, sampling, sector, options):
     """The ring-binned Whittle fit of a map's windowed 2-D periodogram (only the
     wavevectors of ``sector``, if given): a :class:`~rough.fractal.result.FractalFit`."""
@@ -200,15 +205,23 @@ def whittle_map(surface, order, band, resolution, sampling, sector, options):
     refuse_flat(field, surface.heights)
     rings = ring_spectrum(field, power, surface.spacing, low, high, step, sector)
     del field
+    method = "whittle (ring-binned 2-D periodogram)" + ("" if sector is None else ", sector")
+    return fit_rings(rings, surface.spacing, band, resolution, sampling, options, method)
+
+
+def fit_rings(rings, spacing, band, resolution, sampling, options, method):
+    """The Whittle fit of a prepared ring spectrum (see
+    :func:`~rough.fractal.psd.ring_spectrum`; a tiled map's Welch average, for one) over
+    ``band`` (its scaling range when an end is open): a :class:`~rough.fractal.result.FractalFit`."""
     if rings["count"].size < 4:
         raise InputError(f"only {rings['count'].size} frequency rings in the fit band; widen --band")
-    outcome = band_outcome(ring_bins(rings, surface.spacing), MAP_RANGE, band, options)
+    outcome = band_outcome(ring_bins(rings, spacing), MAP_RANGE, band, options)
     count = int(outcome.fit.bins.count.sum()) if outcome.fit else int(rings["count"].sum())
-    method = "whittle (ring-binned 2-D periodogram)" + ("" if sector is None else ", sector")
     settings = Settings(method, "hann (periodic)", sampling[0], sampling[1], 0.0, count)
     return from_outcome(outcome, "map", resolution, settings)
 
 
+@one_blas_thread
 def ring_fit(bins, resolution, options):
     """A sector's fit (rose): Ds and C (at η = ``resolution``) with standard errors
     (None at a bound), the noise RMS (m, None without a floor) and whether the

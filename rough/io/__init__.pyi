@@ -11,6 +11,7 @@ from .reading import ReadOptions as ReadOptions
 from .reading import gunzip as gunzip
 from .reading import read as read
 from .reading import read_bytes as read_bytes
+from .reading import read_options as read_options
 from .receiving import widen_pipe as widen_pipe
 from .registry import describe as describe
 from .registry import sniff as sniff
@@ -18,5 +19,10 @@ from .tables import BINARY as BINARY
 from .tables import EXTENSIONS as EXTENSIONS
 from .tables import FORMATS as FORMATS
 from .tables import WRITABLE as WRITABLE
+from .tiled import TiledSurface as TiledSurface
+from .tiled import memory_budget as memory_budget
+from .tiled import open_surface as open_surface
+from .tiled import open_tiles as open_tiles
+from .tiled import tile_points as tile_points
 from .writing import format_for_path as format_for_path
 from .writing import write as write

@@ -21,7 +21,10 @@ the file was written, not an acquisition time), ``comment`` (ImageDescription) a
 ``channel``/``channels``. Sources: the GDAL raster data model (geotransform, AREA_OR_POINT) and OGC GeoTIFF 1.1.
 
 ``options.window`` is read alone from disk (:func:`read_path`), with the sample range
-:meth:`rough.Surface.crop` would keep, so a DEM larger than memory can be analysed piece by piece.
+:meth:`rough.Surface.crop` would keep, so a DEM larger than memory can be analysed piece by piece;
+:func:`open_tiles` describes the map and reads any window of it on demand (GeoTIFF, COG, and a GDAL
+VRT mosaic of them, sniffed by its ``<VRTDataset`` root), with the same band, scale, unit, nodata,
+orientation and metadata.
 
 The writer makes a north-up float64 GeoTIFF (deflate, floating-point predictor, nodata NaN,
 ``AREA_OR_POINT=Area``) whose geotransform places the pixel centres at the surface's sample positions, in the
@@ -45,15 +48,17 @@ from ..extras import require
 from ..surface import Surface, Units, check_size, index_range
 from . import limits, provenance
 from .registry import Format, channel_metadata, choose_channel
+from .tiled import TiledSurface
+from .windowed import FileSource, finite
 
 FORMAT = Format(
     "geotiff",
     "GeoTIFF elevation model",
     (".tif", ".tiff"),
-    magic=(b"II*\0", b"MM\0*", b"II+\0", b"MM\0+"),
+    magic=(b"II*\0", b"MM\0*", b"II+\0", b"MM\0+", b"<VRTDataset"),
     writes=True,
     writes_profiles=False,
-    carries=("spacing", "units", "metadata", "channels", "mask", "history", "crs"),
+    carries=("spacing", "units", "metadata", "channels", "mask", "history", "crs", "tiles"),
     read_library="rasterio",
     write_library="rasterio",
 )
@@ -83,6 +88,8 @@ CRS_UNITS = {"metre": "m", "meter": "m", "foot": "ft", "kilometre": "km"}
 
 def read(data, options):
     """The surface in a GeoTIFF's bytes (standard input); the caller crops to ``options.window``."""
+    if bytes(data[:11]) == b"<VRTDataset":
+        raise FormatError("a GDAL VRT reads other files, named from where it lies: give its path, not its bytes")
     rasterio = require("rasterio")
     with _quiet(rasterio), rasterio.MemoryFile(bytes(data)) as memory:
         try:
@@ -97,7 +104,7 @@ def read_path(path, options):
     rasterio = require("rasterio")
     try:
         with _quiet(rasterio), rasterio.open(os.fspath(path)) as dataset:
-            return _surface(dataset, options, os.path.getsize(path), window=options.window)
+            return _surface(dataset, options, _file_bytes(dataset), window=options.window)
     except rasterio.errors.RasterioError as error:
         raise FormatError(f"not a readable GeoTIFF ({_one_line(error, os.fspath(path))})") from None
 
@@ -151,24 +158,12 @@ def write_bands(stream, bands, spacing, origin, crs, dtype="float64", tags=None)
 
 
 def _surface(dataset, options, file_bytes, window):
-    names = [description or f"band {number}" for number, description in enumerate(dataset.descriptions, start=1)]
-    band = choose_channel(names, options.channel, 0)
-    grid = _Grid(dataset, options)
-    _check_bytes(dataset, file_bytes)
+    band, grid, metres, (units, metadata, history) = _described(dataset, options, file_bytes)
     ranges = grid.ranges(window)
     what = "the GeoTIFF window" if window else "the GeoTIFF (read a part of it with --crop X0:X1,Y0:Y1)"
     check_size([stop - start for start, stop in ranges], what)
-    metres, z_unit = _height_unit(dataset, band)
     heights = _heights(dataset, band, grid.raster_window(ranges), metres)[grid.flip]
     origin = tuple(grid.origin[axis] + start * grid.spacing[axis] for axis, (start, _) in enumerate(ranges))
-    metadata = {**_facts(dataset), **grid.metadata}
-    if len(names) > 1:
-        metadata.update(channel_metadata(names, band))
-    restored, units, history = provenance.restore(
-        {part: dataset.tags().get(TAGS[part]) for part in provenance.PARTS},
-        units=Units(grid.unit, z_unit),
-    )
-    metadata = {**restored, **metadata}
     if dataset.height == 1:
         surface = Surface(heights[0], grid.spacing[:1], origin[:1], units, metadata, history)
     else:
@@ -177,6 +172,89 @@ def _surface(dataset, options, file_bytes, window):
         return surface
     x, y = window
     return surface.derive("crop", {"x": list(x) if x else None, "y": list(y) if y else None})
+
+
+def _described(dataset, options, file_bytes):
+    """``(band index, _Grid, metres per height unit, (units, metadata, history))`` of a dataset."""
+    names = [description or f"band {number}" for number, description in enumerate(dataset.descriptions, start=1)]
+    band = choose_channel(names, options.channel, 0)
+    grid = _Grid(dataset, options)
+    _check_bytes(dataset, file_bytes)
+    metres, z_unit = _height_unit(dataset, band)
+    metadata = {**_facts(dataset), **grid.metadata}
+    if len(names) > 1:
+        metadata.update(channel_metadata(names, band))
+    restored, units, history = provenance.restore(
+        {part: dataset.tags().get(TAGS[part]) for part in provenance.PARTS},
+        units=Units(grid.unit, z_unit),
+    )
+    return band, grid, metres, (units, {**restored, **metadata}, history)
+
+
+def open_tiles(path, options):
+    """A :class:`~rough.io.tiled.TiledSurface` of a GeoTIFF, COG or VRT map whose windows
+    are read from disk as :func:`read_path` reads them (same band, scale, unit, nodata,
+    flips, spacing, origin and metadata; ``geo`` holds the CRS text, None for a raster
+    without a CRS); None for a one-row raster (a profile, read whole)."""
+    rasterio = require("rasterio")
+    try:
+        with _quiet(rasterio), rasterio.open(os.fspath(path)) as dataset:
+            band, grid, metres, (units, metadata, history) = _described(dataset, options, _file_bytes(dataset))
+            if dataset.height == 1:
+                return None
+            _numeric(dataset, band)
+    except rasterio.errors.RasterioError as error:
+        raise FormatError(f"not a readable GeoTIFF ({_one_line(error, os.fspath(path))})") from None
+    crs = metadata.get("crs")
+    return TiledSurface(
+        GeoTiffSource(path, band, metres, grid.shape, tuple(step.step for step in grid.flip)),
+        grid.shape,
+        tuple(grid.spacing),
+        origin=tuple(grid.origin),
+        units=units,
+        metadata=metadata,
+        history=history,
+        geo=None if crs in (None, UNKNOWN_CRS) else {"crs": crs},
+    )
+
+
+#: MB of GDAL's block cache while a window is read: by default GDAL keeps 5 % of the machine's
+#: memory (1.2 GB here) of decoded blocks, which a map read strip by strip would fill for nothing.
+CACHE_MB = 64
+
+
+class GeoTiffSource(FileSource):
+    """Windows of one band of a raster, in rough's orientation, read through rasterio
+    (GDAL reads only the blocks a window touches); the dataset is opened once per process."""
+
+    def __init__(self, path, band, metres, shape, steps):
+        super().__init__(path)
+        self.band, self.metres, self.shape, self.steps = band, metres, shape, steps
+
+    def opened(self):
+        rasterio = require("rasterio")
+        try:
+            with _quiet(rasterio):
+                return rasterio.open(self.path)
+        except rasterio.errors.RasterioError as error:
+            raise FormatError(f"{self.path}: not a readable GeoTIFF ({_one_line(error, self.path)})") from None
+
+    def window(self, rows, cols):
+        """Rows and columns (slices, step 1, of rough's indices) as float64 metres, NaN invalid."""
+        rasterio = require("rasterio")
+        dataset, lock = self.handle()
+        window = []
+        for part, count, step in zip((rows, cols), self.shape, self.steps):
+            start, stop, _ = part.indices(count)
+            window.append((count - stop, count - start) if step < 0 else (start, stop))
+        try:
+            with lock, _quiet(rasterio), rasterio.Env(GDAL_CACHEMAX=CACHE_MB):
+                heights = _heights(dataset, self.band, tuple(window), self.metres)
+        except rasterio.errors.RasterioError as error:
+            raise FormatError(f"{self.path}: not a readable GeoTIFF ({_one_line(error, self.path)})") from None
+        except FormatError as error:
+            raise FormatError(f"{self.path}: {error}") from None
+        return finite(heights[:: self.steps[0], :: self.steps[1]])
 
 
 class _Grid:
@@ -248,9 +326,7 @@ class _Grid:
 
 def _heights(dataset, band, window, metres):
     """Band ``band``'s heights in ``window`` (file rows and columns), metres, invalid points NaN."""
-    dtype = np.dtype(dataset.dtypes[band])
-    if dtype.kind not in "iuf":
-        raise FormatError(f"band {band + 1} holds {dtype} values, not heights")
+    _numeric(dataset, band)
     values = dataset.read(band + 1, window=window, masked=True)
     scale, offset = dataset.scales[band] * metres, dataset.offsets[band] * metres
     heights = np.asarray(values.data, dtype=np.float64)
@@ -258,6 +334,17 @@ def _heights(dataset, band, window, metres):
         heights = limits.scaled(heights, scale, "the band's scale and unit", offset)
     heights[np.ma.getmaskarray(values)] = np.nan
     return heights
+
+
+def _numeric(dataset, band):
+    dtype = np.dtype(dataset.dtypes[band])
+    if dtype.kind not in "iuf":
+        raise FormatError(f"band {band + 1} holds {dtype} values, not heights")
+
+
+def _file_bytes(dataset):
+    """The bytes of the files that hold a dataset's pixels (a VRT's sources with it)."""
+    return sum(os.path.getsize(name) for name in dataset.files if os.path.isfile(name))
 
 
 def _height_unit(dataset, band):

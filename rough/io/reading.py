@@ -157,14 +157,8 @@ def read(source, *, spacing=None, unit=None, verify=True, channel=None, layer=No
     >>> column.spacing, (column.heights * 1e9).round(6).tolist()  # m, nm
     ((0.001,), [100.0, 200.0, 400.0])
     """
-    options = ReadOptions(
-        spacing=_spacing_tuple(spacing),
-        unit=unit,
-        verify=verify,
-        channel=channel,
-        layer=layer,
-        window=_window(crop),
-        regrid=regrid,
+    options = read_options(
+        spacing=spacing, unit=unit, verify=verify, channel=channel, layer=layer, crop=crop, regrid=regrid
     )
     name = _name(source)
     with _warnings_held():
@@ -181,10 +175,33 @@ def read(source, *, spacing=None, unit=None, verify=True, channel=None, layer=No
     return surface
 
 
+def read_options(spacing=None, unit=None, verify=True, channel=None, layer=None, crop=None, regrid=None):
+    """The :class:`ReadOptions` of :func:`read`'s keywords."""
+    return ReadOptions(
+        spacing=_spacing_tuple(spacing),
+        unit=unit,
+        verify=verify,
+        channel=channel,
+        layer=layer,
+        window=_window(crop),
+        regrid=regrid,
+    )
+
+
 @contextlib.contextmanager
 def _warnings_held():
     """Hold this thread's log records while a file is read: given out once it is read,
     dropped when it is refused, whose one line says what matters."""
+    with held_warnings() as held:
+        yield
+    for record in held:
+        log.handle(record)
+
+
+@contextlib.contextmanager
+def held_warnings():
+    """Hold this thread's log records meanwhile, in the list it yields (for the caller
+    to give out with ``log.handle`` or drop); other threads' records pass."""
     held, thread = [], threading.get_ident()
 
     def hold(record):
@@ -195,11 +212,9 @@ def _warnings_held():
 
     log.addFilter(hold)
     try:
-        yield
+        yield held
     finally:
         log.removeFilter(hold)
-    for record in held:
-        log.handle(record)
 
 
 @contextlib.contextmanager

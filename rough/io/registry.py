@@ -80,6 +80,7 @@ CARRIES = {
     "mask": "invalid-point mask",
     "history": "rough's history",
     "crs": "coordinate reference system",
+    "tiles": "maps read a window at a time (larger than memory)",
 }
 
 #: What names a height channel, in any reader's channel names or titles: a height,

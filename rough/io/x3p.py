@@ -31,6 +31,12 @@ NaN outside the points' convex hull, recorded as a ``regrid`` history entry. Map
 always interpolated linearly (the band-limited method is for profiles). A profile with
 unevenly spaced absolute x goes through :func:`rough.io.regrid.profile_from_points`.
 
+Windows (:func:`open_tiles`): a map on an incremental grid whose data member is stored
+(memory-mapped) or deflated (unpacked as far as each window) is read a window at a
+time, with the scaling, layer and mask of :func:`read`; its MD5 is checked (or its
+CRC-32, as above) in one pass when it is opened, before any window is read. Profiles,
+point clouds, DataList, absolute or rotated axes are read whole.
+
 Writing: PRF for profiles, SUR for maps, float64 data, stored (uncompressed) members
 with the data aligned to 64 bytes, and rough's units, metadata and history in a
 vendor-specific member named by the root's ``VendorSpecificID``, which other readers
@@ -41,7 +47,9 @@ before it arrives; ZIP64 fields where a size or offset needs them
 
 Checksums, once per stage: the MD5 and the zip CRC-32 of ``bindata/data.bin`` are
 computed in one pass over its bytes. A stream (standard input, a file) is hashed as it
-arrives (:func:`rough.io.receiving.receive`), so hashing overlaps reading. The MD5 is
+arrives (:func:`rough.io.receiving.receive`), so hashing overlaps reading; a deflated
+member is hashed as it is unpacked, in a worker thread beside zlib
+(:func:`rough.io.x3pdata.inflated`). The MD5 is
 checked against main.xml (a mismatch refuses the file unless ``verify=False``); the
 CRC-32 is checked only where no MD5 is. Heights
 written unchanged reuse both (they view the read-only bytes they were checked on);
@@ -62,8 +70,10 @@ from .. import __version__
 from .. import io as rough_io  # lazy: rough.io.gridding (scipy) loads only when points are gridded
 from ..errors import FormatError
 from ..surface import Surface, Units, timestamp
-from . import limits, provenance, receiving, regrid, ziparchive
+from . import provenance, receiving, regrid, windowed, ziparchive
 from .registry import Format
+from .tiled import TiledSurface
+from .x3pdata import DataSource, check, checked_member, open_data, scaled
 
 FORMAT = Format(
     "x3p",
@@ -71,7 +81,7 @@ FORMAT = Format(
     (".x3p",),
     magic=(b"PK\x03\x04", b"PK\x05\x06"),
     writes=True,
-    carries=("spacing", "exact-grid", "units", "metadata", "time", "layers", "mask", "history"),
+    carries=("spacing", "exact-grid", "units", "metadata", "time", "layers", "mask", "history", "tiles"),
 )
 
 NAMESPACE = "http://www.opengps.eu/2008/ISO5436_2"
@@ -89,42 +99,16 @@ log = logging.getLogger("rough")
 
 def read(data, options):
     data = data if isinstance(data, bytes) else memoryview(data).cast("B")
-    try:
-        archive = zipfile.ZipFile(ziparchive.ViewFile(data))
-    except (*ziparchive.ZIP_ERRORS, ValueError) as error:
-        raise FormatError(f"not a valid X3P zip archive ({error})") from None
-    prefix, main_name = _find_main(archive)
-    document = ziparchive.member(archive, main_name, data, limit=MAX_XML_BYTES)
-    root = _parse_xml(bytes(document))
-    _check(options.verify, _main_checksum_problem(archive, prefix, root, document, data))
-
-    feature = _text(root, "Record1/FeatureType", required=True).upper()
-    if feature not in ("SUR", "PRF", "PCL"):
-        raise FormatError(f"unknown X3P FeatureType {feature!r} (expected SUR, PRF or PCL)")
-    axes = {name: _axis(root, name) for name in ("CX", "CY", "CZ")}
-    if axes["CZ"]["type"] != "A":
-        raise FormatError("the X3P z axis (CZ) must be absolute (AxisType A)")
-    rotation = _rotation(root)
-    cloud = feature == "PCL" or root.find("Record3/ListDimension") is not None
-    if cloud:
-        if axes["CX"]["type"] != "A" or axes["CY"]["type"] != "A":
-            raise FormatError("X3P point clouds need absolute CX and CY axes (AxisType A)")
-        nx, ny, layers = _size(root, "Record3/ListDimension"), 1, 1
-    else:
-        nx, ny, layers = (_size(root, f"Record3/MatrixDimension/Size{c}") for c in "XYZ")
-    if nx * ny * layers > MAX_POINTS:
-        raise FormatError(f"Record3 declares {nx}×{ny}×{layers} points, more than rough handles")
-    if feature == "PRF" and ny != 1:
-        raise FormatError(f"an X3P profile (PRF) must have SizeY 1, not {ny}")
-    absolute = [name for name in ("CX", "CY") if axes[name]["type"] == "A"]
-    fields = [(name, axes[name]["dtype"]) for name in (*absolute, "CZ")]
-    count = nx * ny * layers
+    header = _Header(data, options)
+    archive, prefix, root = header.archive, header.prefix, header.root
+    nx, ny, layers = header.nx, header.ny, header.layers
     digest = None
     if root.find("Record3/DataLink") is not None:
-        records, valid, digest = _binary_records(archive, prefix, root, data, fields, count, options.verify)
+        count = nx * ny * layers
+        records, valid, digest = _binary_records(archive, prefix, root, data, header.fields, count, options.verify)
         stored = (receiving.address(records), records.nbytes)  # where data.bin's bytes are
     elif root.find("Record3/DataList") is not None:
-        records, valid = _list_records(root, fields, count)
+        records, valid = _list_records(root, header.fields, nx * ny * layers)
     else:
         raise FormatError("Record3 has neither a DataLink nor a DataList: no data")
     layer = _chosen_layer(options.layer, layers)
@@ -132,24 +116,52 @@ def read(data, options):
     records = records[chosen]
     valid = None if valid is None or valid[chosen].all() else valid[chosen]
 
-    points = _Points(axes, records, valid, rotation, nx)
-    if cloud:
+    points = _Points(header.axes, records, valid, header.rotation, nx)
+    if header.cloud:
         placed = rough_io.gridding.grid_points(*points.placed(), options, f"an X3P point cloud of {nx} points")
     elif ny == 1:
         placed = _profile(points, nx, options)
     else:
         placed = _surface(points, nx, ny, options)
     heights, spacing, origin, notes, steps = placed
-    if _text(root, "VendorSpecificID") == VENDOR_ID and f"{prefix}{VENDOR_MEMBER}" in archive.namelist():
-        metadata, units, history = _vendor(archive, prefix, data)
-    else:
-        metadata, units, history = _metadata(root), Units("m", "m"), []
-    if layers > 1:
-        metadata.update(layer=str(layer), layers=str(layers))
+    metadata, units, history = _provenance(header, data, layer)
     surface = Surface(heights, spacing, origin, units, {**metadata, **notes}, history + steps)
     if digest and _same_bytes(surface.heights, stored):
         _remember_digest(surface.heights, digest)
     return surface
+
+
+def open_tiles(path, options):
+    """A :class:`~rough.io.tiled.TiledSurface` of a binary X3P map read a window at a
+    time from disk (a stored data member memory-mapped, a deflated one decompressed as
+    far as each window), with the data's MD5 checked in one pass now, as :func:`read`
+    checks it; None for what is read whole: profiles, point clouds, inline DataList,
+    absolute or rotated axes, and data compressed otherwise than by deflate."""
+    data = windowed.mapped(path)
+    header = _Header(data, options)
+    axes, root = header.axes, header.root
+    if (
+        header.feature != "SUR"
+        or header.cloud
+        or header.ny == 1
+        or header.rotation is not None
+        or "A" in (axes["CX"]["type"], axes["CY"]["type"])
+        or root.find("Record3/DataLink") is None
+    ):
+        return None
+    spacing = tuple(_increment(name, axes[name]) for name in ("CX", "CY"))
+    link = _text(root, "Record3/DataLink/PointDataLink", required=True)
+    count, dtype = header.nx * header.ny * header.layers, np.dtype(axes["CZ"]["dtype"])
+    stated = _text(root, "Record3/DataLink/MD5ChecksumPointData")
+    info = open_data(header.archive, header.prefix, link, data, stated, options.verify, count * dtype.itemsize)
+    if info is None:
+        return None
+    mask = _mask(header.archive, header.prefix, root, data, count, options.verify)[0]
+    layer = _chosen_layer(options.layer, header.layers)
+    metadata, units, history = _provenance(header, data, layer)
+    source = DataSource(path, info.filename, mask, (dtype.str, header.nx, layer * header.ny), axes["CZ"])
+    origin = (0.0 + axes["CX"]["offset"], 0.0 + axes["CY"]["offset"])  # as _surface places them
+    return TiledSurface(source, (header.ny, header.nx), spacing, origin, units, metadata, history)
 
 
 def write(surface, stream):
@@ -174,6 +186,52 @@ def write(surface, stream):
 
 
 # -- reading -------------------------------------------------------------------------
+
+
+class _Header:
+    """An X3P archive's main.xml, its checksum checked, and the grid it declares."""
+
+    def __init__(self, data, options):
+        try:
+            self.archive = zipfile.ZipFile(ziparchive.ViewFile(data))
+        except (*ziparchive.ZIP_ERRORS, ValueError) as error:
+            raise FormatError(f"not a valid X3P zip archive ({error})") from None
+        self.prefix, main_name = _find_main(self.archive)
+        document = ziparchive.member(self.archive, main_name, data, limit=MAX_XML_BYTES)
+        root = self.root = _parse_xml(bytes(document))
+        check(options.verify, _main_checksum_problem(self.archive, self.prefix, root, document, data))
+        self.feature = _text(root, "Record1/FeatureType", required=True).upper()
+        if self.feature not in ("SUR", "PRF", "PCL"):
+            raise FormatError(f"unknown X3P FeatureType {self.feature!r} (expected SUR, PRF or PCL)")
+        axes = self.axes = {name: _axis(root, name) for name in ("CX", "CY", "CZ")}
+        if axes["CZ"]["type"] != "A":
+            raise FormatError("the X3P z axis (CZ) must be absolute (AxisType A)")
+        self.rotation = _rotation(root)
+        self.cloud = self.feature == "PCL" or root.find("Record3/ListDimension") is not None
+        if self.cloud:
+            if axes["CX"]["type"] != "A" or axes["CY"]["type"] != "A":
+                raise FormatError("X3P point clouds need absolute CX and CY axes (AxisType A)")
+            self.nx, self.ny, self.layers = _size(root, "Record3/ListDimension"), 1, 1
+        else:
+            self.nx, self.ny, self.layers = (_size(root, f"Record3/MatrixDimension/Size{c}") for c in "XYZ")
+        if self.nx * self.ny * self.layers > MAX_POINTS:
+            raise FormatError(f"Record3 declares {self.nx}×{self.ny}×{self.layers} points, more than rough handles")
+        if self.feature == "PRF" and self.ny != 1:
+            raise FormatError(f"an X3P profile (PRF) must have SizeY 1, not {self.ny}")
+        absolute = [name for name in ("CX", "CY") if axes[name]["type"] == "A"]
+        self.fields = [(name, axes[name]["dtype"]) for name in (*absolute, "CZ")]
+
+
+def _provenance(header, data, layer):
+    """``(metadata, units, history)``: rough's own record, else Record2's facts; the layer read."""
+    archive, prefix = header.archive, header.prefix
+    if _text(header.root, "VendorSpecificID") == VENDOR_ID and f"{prefix}{VENDOR_MEMBER}" in archive.namelist():
+        metadata, units, history = _vendor(archive, prefix, data)
+    else:
+        metadata, units, history = _metadata(header.root), Units("m", "m"), []
+    if header.layers > 1:
+        metadata.update(layer=str(layer), layers=str(header.layers))
+    return metadata, units, history
 
 
 def _find_main(archive):
@@ -217,14 +275,6 @@ def _main_checksum_problem(archive, prefix, root, document, data):
         shown = stated[0][:32].decode("ascii", "replace") if stated else "nothing"
         return f"main.xml checksum mismatch ({name} says {shown}, main.xml is {actual})"
     return None
-
-
-def _check(verify, problem):
-    if problem is None:
-        return
-    if verify:
-        raise FormatError(f"{problem}; the file may be damaged (--ignore-checksums reads it anyway)")
-    log.warning("%s; reading anyway", problem)
 
 
 def _text(root, path, required=False, default=None):
@@ -281,38 +331,27 @@ def _binary_records(archive, prefix, root, data, fields, count, verify):
     record = np.dtype(fields)
     stated = _text(root, "Record3/DataLink/MD5ChecksumPointData")
     size = count * record.itemsize
-    payload, actual, crc = _checked_member(archive, prefix, link, data, stated, verify, expected=size)
+    payload, actual, crc = checked_member(archive, prefix, link, data, stated, verify, expected=size)
     records = np.frombuffer(payload, dtype=record)
     verified = (actual, crc) if stated and stated.lower() == actual else None
-    valid_link = _text(root, "Record3/DataLink/ValidPointsLink")
-    if valid_link is None:
+    packed = _mask(archive, prefix, root, data, count, verify)[1]
+    if packed is None:
         return records, None, verified
-    stated = _text(root, "Record3/DataLink/MD5ChecksumValidPoints")
-    packed, _, _ = _checked_member(archive, prefix, valid_link, data, stated, verify, limit=MAX_POINTS // 8 + 1)
-    if len(packed) < (count + 7) // 8:
-        raise FormatError(f"{valid_link} holds {len(packed)} bytes, too few for {count} points")
     valid = np.unpackbits(np.frombuffer(packed, np.uint8), count=count, bitorder="little").astype(bool)
     return records, valid, verified
 
 
-def _checked_member(archive, prefix, link, data, stated, verify, **sizes):
-    """``(bytes, MD5 hex, CRC-32)`` of a binary member, hashed once (or on the way in,
-    by :func:`rough.io.receiving.receive`): its MD5 checked against ``stated``, its zip CRC-32 only when
-    there is no MD5 to check."""
-    info, content = ziparchive.located(archive, f"{prefix}{link}", data, **sizes)
-    actual, crc = receiving.arrived(content) or receiving.hashes(content)
-    if not (verify and stated) and crc != info.CRC:
-        raise FormatError(f"{prefix}{link} fails its zip CRC check: the archive is damaged")
-    _check(verify, _md5_problem(actual, stated, link))
-    return content, actual, crc
-
-
-def _md5_problem(actual, stated, name):
-    if stated is None:
-        return f"main.xml gives no MD5 checksum for {name}"
-    if stated.lower() != actual:
-        return f"{name} checksum mismatch (main.xml says {stated}, the data are {actual})"
-    return None
+def _mask(archive, prefix, root, data, count, verify):
+    """``(zip name, packed bits)`` of the valid-point mask (its checksum and size
+    checked), or ``(None, None)``."""
+    valid_link = _text(root, "Record3/DataLink/ValidPointsLink")
+    if valid_link is None:
+        return None, None
+    stated = _text(root, "Record3/DataLink/MD5ChecksumValidPoints")
+    packed, _, _ = checked_member(archive, prefix, valid_link, data, stated, verify, limit=MAX_POINTS // 8 + 1)
+    if len(packed) < (count + 7) // 8:
+        raise FormatError(f"{valid_link} holds {len(packed)} bytes, too few for {count} points")
+    return f"{prefix}{valid_link}", packed
 
 
 def _list_records(root, fields, count):
@@ -332,15 +371,6 @@ def _list_records(root, fields, count):
             raise FormatError(f"Datum {index + 1} has {len(values)} values, needs {width}: {text!r}")
         records[index] = tuple(float(v) for v in values[-width:])
     return records, valid
-
-
-def _scaled(raw, axis, offset=True):
-    values = raw.astype(np.float64) if raw.dtype != np.float64 else raw
-    factor = axis["increment"] if axis["code"] in ("I", "L") else 1.0
-    shift = axis["offset"] if offset else 0.0
-    if factor == 1.0 and not shift:
-        return values
-    return limits.scaled(values, factor, f"the Increment {factor!r} and Offset {shift!r}", shift)
 
 
 def _chosen_layer(wanted, layers):
@@ -405,7 +435,7 @@ class _Points:
         self.axes, self.records, self.valid, self.rotation, self.nx = axes, records, valid, rotation, nx
 
     def heights(self):
-        z = _scaled(self.records["CZ"], self.axes["CZ"])
+        z = scaled(self.records["CZ"], self.axes["CZ"])
         if self.valid is None or np.isnan(z[~self.valid]).all():  # as rough writes them: no copy
             return z
         return np.where(self.valid, z, np.nan)
@@ -416,13 +446,13 @@ class _Points:
         if axis["type"] == "I":
             index = np.arange(len(self.records))
             return (index % self.nx if name == "CX" else index // self.nx) * _increment(name, axis)
-        values = _scaled(self.records[name], axis, offset=False)
+        values = scaled(self.records[name], axis, offset=False)
         return values if self.valid is None else np.where(self.valid, values, np.nan)
 
     def placed(self):
         """x, y and z of the valid points where the placement puts them: rotated, then
         shifted by the axis offsets."""
-        z = _scaled(self.records["CZ"], self.axes["CZ"], offset=False)
+        z = scaled(self.records["CZ"], self.axes["CZ"], offset=False)
         coordinates = np.stack([self.local("CX"), self.local("CY"), z])
         if self.rotation is not None:
             coordinates = self.rotation @ coordinates

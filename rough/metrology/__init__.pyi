@@ -41,6 +41,10 @@ from .segmentation import feature_parameters as feature_parameters
 from .segmentation import motif_parameters as motif_parameters
 from .segmentation import segment as segment
 from .segmentation import undefined_reasons as undefined_reasons
+from .tiled import TiledEvaluation as TiledEvaluation
+from .tiled import tiled_evaluation as tiled_evaluation
+from .tiled import tiled_parameters as tiled_parameters
+from .tiled_polynomial import tiled_form as tiled_form
 from .tip import PRESETS as PRESETS
 from .tip import closing_envelope as closing_envelope
 from .tip import traced as traced

@@ -1,35 +1,48 @@
 """What ``rough info`` reports: the facts of a surface, in SI units."""
 
+import fractions
+import math
+
 import numpy as np
 
+from .. import tasks
+from ..io.tiled import TiledSurface
+from .heights import SUBNORMAL, exact_sum
 
-def summary(surface):
+
+def summary(surface, *, budget=None, jobs=1, scheduler=None):
     """Shape, spacing, size, valid points, height range and RMS height of a surface.
 
     NaN points are counted as invalid and left out of every statistic. ``rms_height``
     (Rq for a profile, Sq for a map) is taken about the mean of the valid points, with
     no levelling. Lengths are in metres; ``points``/``spacing``/``size`` list x first.
-    Returns None for the statistics when no point is valid.
+    Returns None for the statistics when no point is valid. A
+    :class:`~rough.io.TiledSurface` is read a strip at a time (twice: the mean, then
+    the squares about it, in strips sized by the memory ``budget`` in bytes, on
+    ``jobs`` processes or a Dask ``scheduler``: :func:`rough.tasks.map_ordered`); its
+    facts equal those of the map read whole, to rounding.
     """
-    heights = surface.heights
-    valid = heights[~np.isnan(heights)]
-    stats = {"min": None, "max": None, "mean": None, "rms": None}
-    if valid.size:
-        mean = valid.mean()
-        stats = {
-            "min": float(valid.min()),
-            "max": float(valid.max()),
-            "mean": float(mean),
-            "rms": float(np.sqrt(np.mean((valid - mean) ** 2))),
-        }
+    if isinstance(surface, TiledSurface):
+        count, stats = _tiled_statistics(surface, budget, {"jobs": jobs, "scheduler": scheduler})
+    else:
+        valid = surface.heights[~np.isnan(surface.heights)]
+        count, stats = valid.size, {"min": None, "max": None, "mean": None, "rms": None}
+        if valid.size:
+            mean = valid.mean()
+            stats = {
+                "min": float(valid.min()),
+                "max": float(valid.max()),
+                "mean": float(mean),
+                "rms": float(np.sqrt(np.mean((valid - mean) ** 2))),
+            }
     return {
         "kind": surface.kind,
         "shape": list(surface.points),
         "spacing": list(surface.spacing),
         "size": list(surface.size),
         "origin": list(surface.origin),
-        "points": int(heights.size),
-        "valid_points": int(valid.size),
+        "points": int(math.prod(surface.points)),
+        "valid_points": int(count),
         "z_min": stats["min"],
         "z_max": stats["max"],
         "z_mean": stats["mean"],
@@ -38,3 +51,37 @@ def summary(surface):
         "metadata": dict(surface.metadata),
         "history": list(surface.history),
     }
+
+
+def _tiled_statistics(tiled, budget, run):
+    """(valid points, {min, max, mean, rms}) of a map read a strip at a time."""
+    rows = tiled.strip_rows(budget)
+    strips = [(tiled, first, rows) for first in range(0, tiled.shape[0], rows)]
+    parts = list(tasks.map_ordered(_strip_extent, strips, **run))
+    count = sum(part[0] for part in parts)
+    if not count:
+        return 0, {"min": None, "max": None, "mean": None, "rms": None}
+    mean = float(fractions.Fraction(sum(part[1] for part in parts), count << SUBNORMAL))
+    squares = math.fsum(tasks.map_ordered(_strip_squares, [(*strip, mean) for strip in strips], **run))
+    low = min(part[2] for part in parts if part[0])
+    high = max(part[3] for part in parts if part[0])
+    return count, {"min": low, "max": high, "mean": mean, "rms": math.sqrt(squares / count)}
+
+
+def _strip_extent(item):
+    tiled, first, rows = item
+    values = _valid(tiled, first, rows)
+    if not values.size:
+        return 0, 0, math.nan, math.nan
+    return values.size, exact_sum(values), float(values.min()), float(values.max())
+
+
+def _strip_squares(item):
+    tiled, first, rows, mean = item
+    deviation = _valid(tiled, first, rows) - mean
+    return math.fsum(np.square(deviation))
+
+
+def _valid(tiled, first, rows):
+    heights = tiled.read(slice(first, first + rows))
+    return heights[~np.isnan(heights)]

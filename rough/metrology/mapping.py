@@ -4,8 +4,12 @@ A window of ``wy × wx`` points is moved over the map by a step; each window has
 least-squares polynomial form removed (the Legendre basis of :mod:`rough.metrology.form`,
 fitted on its valid points) before its parameters are taken. The output is a grid of the
 window centres, whose spacing is the step. The work goes one row of windows at a time
-(:func:`_row_of_windows` takes the band of input rows those windows cover), so a reader of
-tiles can feed it band by band later; here the bands are cut from a map in memory.
+(:func:`_row_of_windows` takes the band of input rows those windows cover), in tasks of a
+few rows of windows each (:func:`_band_of_rows`): a task reads its own band of input rows,
+from a :class:`~rough.io.TiledSurface` (a map larger than memory, read a strip at a time)
+or from the map in memory, so the tasks can run in worker processes or on a cluster
+(:func:`rough.tasks.map_ordered`). Each window is computed whole in every case, so the
+results are the same bit for bit however the work is split and wherever it runs.
 
 The cheap moments (Sa, Sq, Ssk, Sku, Sp, Sv, Sz) and the form are computed for a whole
 row of windows at once with numpy; the other parameters (Sdq, Sdr, Sal, Str, Std and the
@@ -26,10 +30,11 @@ import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 from numpy.polynomial import legendre
 
-from .. import fractal
+from .. import fractal, tasks
 from ..errors import InputError, RoughError
 from ..io import geotiff, writing
 from ..io.atomic import atomic_output
+from ..io.tiled import ArraySource, TiledSurface, memory_budget, tile_points
 from ..progress import progress
 from ..surface import Surface
 from .areal import AREAL, gradient_means
@@ -74,6 +79,11 @@ class RoughnessMap:
         Per parameter, why windows got NaN: reason → number of windows.
     metadata : dict of str
         The input's metadata (its ``crs`` among them), carried to the output.
+    tiled : dict or None
+        For a :class:`~rough.io.TiledSurface` input, how it was read: ``tile_rows``
+        (input rows a band reads at most), ``tiles`` (bands), ``exact`` (every
+        parameter: each window is computed whole) and ``estimated`` (none); None for a
+        map in memory.
     """
 
     values: dict
@@ -85,6 +95,7 @@ class RoughnessMap:
     order: int
     reasons: dict
     metadata: dict
+    tiled: dict = None
 
     def surface(self, name):
         """The map of parameter ``name`` as a :class:`~rough.Surface` on the window-centre
@@ -104,7 +115,10 @@ class RoughnessMap:
             summary[name].update(undefined=int(values.size - valid.size), reasons=dict(self.reasons[name]))
         shape = next(iter(self.values.values())).shape
         grid = {"origin": list(self.origin), "spacing": list(self.spacing), "shape": [shape[1], shape[0]]}
-        return {"parameters": summary, "grid": grid, "window": list(self.window), "step": list(self.step)}
+        document = {"parameters": summary, "grid": grid, "window": list(self.window), "step": list(self.step)}
+        if self.tiled is not None:
+            document["tiled"] = dict(self.tiled)
+        return document
 
     @staticmethod
     def output_format(path, parameters):
@@ -134,14 +148,16 @@ class RoughnessMap:
             geotiff.write_bands(stream, bands, self.spacing, self.origin, self.metadata.get("crs"), "float32", tags)
 
 
-def roughness_map(surface, window, step=None, parameters=("Sq",), order=1):
+def roughness_map(surface, window, step=None, parameters=("Sq",), order=1, *, jobs=1, scheduler=None, budget=None):
     """Parameters of a map in windows moved over it: a roughness map.
 
     Parameters
     ----------
-    surface : Surface
-        A map. NaN points are left out of each window's form and parameters; a window
-        with fewer than half its points valid gives NaN for every parameter. The fractal
+    surface : Surface or rough.io.TiledSurface
+        A map, in memory or read a band of rows at a time (a map larger than memory:
+        :func:`rough.io.open_surface`); the results are the same. NaN points are left
+        out of each window's form and parameters; a window with fewer than half its
+        points valid gives NaN for every parameter. The fractal
         fit needs a gap-free window: windows with any NaN point get NaN for ``hurst``,
         ``dimension`` and ``amplitude``.
     window : int or float or tuple
@@ -159,6 +175,16 @@ def roughness_map(surface, window, step=None, parameters=("Sq",), order=1):
         ``lay`` (Std).
     order : int, default 1
         The degree of the polynomial form removed from each window (1: a plane).
+    jobs : int, default 1
+        Worker processes working on bands of windows at once (0: one per core).
+    scheduler : str or distributed.Client, optional
+        A Dask scheduler's address (``tcp://host:8786``) or client: the bands are
+        worked on by its workers, which need ``rough`` and, for a tiled input, its
+        file (see :func:`rough.tasks.map_ordered`).
+    budget : int, optional
+        The memory budget in bytes that sizes the bands (default
+        :func:`rough.io.memory_budget`); a band holds at most
+        :func:`rough.io.tile_points` of it.
 
     Returns
     -------
@@ -196,7 +222,7 @@ def roughness_map(surface, window, step=None, parameters=("Sq",), order=1):
         raise InputError(
             f"unknown parameter {', '.join(unknown) or '(none given)'}; known: {', '.join(MAP_PARAMETERS)}"
         )
-    ny, nx = surface.heights.shape
+    ny, nx = surface.shape if isinstance(surface, TiledSurface) else surface.heights.shape
     size = _points(window, surface.spacing, "window")
     stride = size if step is None else _points(step, surface.spacing, "step")
     if min(size) < SMALLEST_WINDOW:
@@ -208,16 +234,23 @@ def roughness_map(surface, window, step=None, parameters=("Sq",), order=1):
     columns, rows = ((n - w) // s + 1 for n, w, s in zip((nx, ny), size, stride))
     values = {name: np.full((rows, columns), math.nan) for name in parameters}
     reasons = {name: collections.Counter() for name in parameters}
-    basis = _basis(size, order)
-    template = Surface(np.zeros((2, 2)), surface.spacing, None, surface.units, {}, surface.history)
+    tiled = isinstance(surface, TiledSurface)
+    per_task = _rows_per_task(nx, rows, size[1], stride[1], budget)
+    settings = _Settings(size, stride, order, parameters, tuple(surface.spacing), surface.units, surface.history)
+    items = (_item(surface, first, min(per_task, rows - first), settings) for first in range(0, rows, per_task))
+    done = 0
     with progress(total=rows, description="windows", unit="row") as bar:
-        for row in range(rows):
-            top = row * stride[1]
-            band = surface.heights[top : top + size[1]]
-            found = _row_of_windows(band, template, size, stride[0], order, basis, parameters, reasons)
-            for name, row_values in found.items():
-                values[name][row] = row_values
-            bar.update(1)
+        for found, counts in tasks.map_ordered(_band_of_rows, items, jobs=jobs, scheduler=scheduler):
+            for row_values in found:
+                for name, row in row_values.items():
+                    values[name][done] = row
+                done += 1
+            for name, counted in counts.items():
+                reasons[name].update(counted)
+            bar.update(len(found))
+    metadata = dict(surface.metadata)
+    if tiled and surface.geo and "crs" not in metadata:
+        metadata["crs"] = surface.geo["crs"]
     (dx, dy), (x0, y0) = surface.spacing, surface.origin
     return RoughnessMap(
         values,
@@ -228,8 +261,77 @@ def roughness_map(surface, window, step=None, parameters=("Sq",), order=1):
         stride,
         order,
         {name: dict(counts) for name, counts in reasons.items()},
-        dict(surface.metadata),
+        metadata,
+        _tiling(rows, per_task, size[1], stride[1], parameters) if tiled else None,
     )
+
+
+@dataclasses.dataclass(frozen=True)
+class _Settings:
+    """What every band's task needs besides its rows (small: it travels with each)."""
+
+    size: tuple
+    stride: tuple
+    order: int
+    parameters: list
+    spacing: tuple
+    units: object
+    history: list
+
+
+#: Bands a map is cut into at least (when it has that many rows of windows), so that
+#: workers finish together; the same with and without them, so the output is too.
+LEAST_BANDS = 16
+
+
+def _rows_per_task(nx, rows, window, stride, memory):
+    """Rows of windows a task works on: as many as fit :func:`~rough.io.tiled.tile_points`
+    of the ``memory`` budget (at least one), and few enough to make :data:`LEAST_BANDS`
+    bands."""
+    points = tile_points(memory_budget() if memory is None else memory)
+    fitting = max(1, (points // nx - window) // stride + 1)
+    return min(fitting, max(1, -(-rows // LEAST_BANDS)))
+
+
+def _item(surface, first, count, settings):
+    """A task's item: ``(source, base, first, count, settings)``: the rows of windows
+    ``first`` … ``first + count - 1``, read from ``source`` whose row 0 is input row
+    ``base``. A tiled map is its own source (the task reads its band); a map in memory
+    gives a view of the band alone (so that only the band travels to a cluster)."""
+    if isinstance(surface, TiledSurface):
+        return surface, 0, first, count, settings
+    top = first * settings.stride[1]
+    band = surface.heights[top : top + (count - 1) * settings.stride[1] + settings.size[1]]
+    return TiledSurface(ArraySource(band), band.shape, settings.spacing), top, first, count, settings
+
+
+def _band_of_rows(item):
+    """One task: ``(found, reasons)``, the parameters of each of the item's rows of
+    windows (a list of ``{name: values}``) and why windows were NaN (``{name: Counter}``)."""
+    source, base, first, count, settings = item
+    size, stride = settings.size, settings.stride
+    top = first * stride[1]
+    band = source.read(rows=slice(top - base, top - base + (count - 1) * stride[1] + size[1]))
+    basis = _basis(size, settings.order)
+    template = Surface(np.zeros((2, 2)), settings.spacing, None, settings.units, {}, settings.history)
+    reasons = {name: collections.Counter() for name in settings.parameters}
+    found = []
+    for row in range(count):
+        rows = band[row * stride[1] : row * stride[1] + size[1]]
+        found.append(
+            _row_of_windows(rows, template, size, stride[0], settings.order, basis, settings.parameters, reasons)
+        )
+    return found, reasons
+
+
+def _tiling(rows, per_task, window, stride, parameters):
+    """The ``tiled`` record of a map read in bands: every window is computed whole."""
+    return {
+        "tile_rows": (per_task - 1) * stride + window,
+        "tiles": -(-rows // per_task),
+        "exact": list(parameters),
+        "estimated": {},
+    }
 
 
 def _points(length, spacing, what):
@@ -260,6 +362,22 @@ def _row_of_windows(band, template, size, stride, order, basis, parameters, reas
     surface with the input's spacing, units and history, from which the windows the
     per-window functions need are derived; ``reasons`` counts why windows are NaN."""
     windows = sliding_window_view(band, (size[1], size[0]))[0, ::stride]
+    group = max(1, GROUP_POINTS // (size[0] * size[1]))
+    parts = [
+        _group_of_windows(windows[start : start + group], template, size, order, basis, parameters, reasons)
+        for start in range(0, len(windows), group)
+    ]
+    return {name: np.concatenate([part[name] for part in parts]) for name in parameters}
+
+
+#: Points of the windows levelled at once: the arrays of a group (heights, weights,
+#: residuals) stay near 32 MB each, whatever the window, so a band of 1024-point windows
+#: across a 32768-point DEM does not take gigabytes.
+GROUP_POINTS = 1 << 22
+
+
+def _group_of_windows(windows, template, size, order, basis, parameters, reasons):
+    """:func:`_row_of_windows` for some of the row's windows (``windows``: a view)."""
     heights = windows.reshape(len(windows), -1)
     valid = ~np.isnan(heights)
     count = valid.sum(axis=1)

@@ -58,6 +58,7 @@ import math
 import numpy as np
 from scipy.special import ndtr, ndtri
 
+from ..compiled import compiled
 from ..errors import InputError
 from .heights import BLOCK, ROUNDING, valid_values
 from .profile import combined, map_profiles
@@ -65,6 +66,7 @@ from .profile import combined, map_profiles
 CENTRAL_REGION = 40.0  # % of material ratio, ISO 13565-2 and ISO 25178-2
 PROBABILITY_RANGE = 3.0  # standard deviations either side of the mean, ISO 13565-3
 LEAST_REGION = 0.05  # fraction of the points each line of the probability fit spans at least
+COMPILED_SUMS = 1 << 22  # points from which the fit's running sums are one compiled pass
 
 PROFILE_FUNCTIONAL = {
     "Rmr": ("%", "material ratio Rmr(c) at the height c"),
@@ -377,10 +379,7 @@ def _two_lines(q, h):
     stride = max(1, (n - 2 * least) // 1024)
     coarse = np.arange(least, n - least, stride)
     ends = np.append(coarse, n)
-    sums = {}
-    for name, values in _moments(q, h):
-        sums[name] = _cumulative(values)[ends - 1]
-        del values  # before the next moment is made
+    sums = _sums_at(q, h, ends)
     tolerance = ROUNDING * float(sums["hh"][-1])  # residuals this close are equal to the precision of the sums
     residual, _ = _broken_lines(q, sums, ends)
     best = _first_least(residual, tolerance)
@@ -393,6 +392,37 @@ def _two_lines(q, h):
     intercept, valley, plateau = coefficients[best]
     deviate = float(q[fine[best]])
     return ProbabilityFit(float(plateau), float(valley), float(100.0 * ndtr(-deviate)), deviate, float(intercept))
+
+
+def _sums_at(q, h, ends):
+    """The running sums of the moments of :func:`_moments` at the indices ``ends - 1``
+    (increasing): a cumulative sum of each moment in turn, or on :data:`COMPILED_SUMS`
+    points or more one compiled pass over all five, with the same additions in the
+    same order (numba, :func:`rough.compiled.compiled`)."""
+    if q.size >= COMPILED_SUMS:
+        return dict(zip(("q", "qq", "h", "qh", "hh"), compiled(_running_sums)(q, h, ends)))
+    sums = {}
+    for name, values in _moments(q, h):
+        sums[name] = _cumulative(values)[ends - 1]
+        del values  # before the next moment is made
+    return sums
+
+
+def _running_sums(q, h, ends):
+    """Rows q, q², h, qh, h² of the running sums at ``ends - 1``, each added up from
+    the first point on as ``np.cumsum`` does. Plain Python, compiled by
+    :func:`_sums_at`."""
+    table = np.empty((5, ends.size))
+    sq, sqq, sh, sqh, shh = q[0], q[0] * q[0], h[0], q[0] * h[0], h[0] * h[0]
+    k = 0
+    for i in range(ends[-1]):
+        if i:
+            a, b = q[i], h[i]
+            sq, sqq, sh, sqh, shh = sq + a, sqq + a * a, sh + b, sqh + a * b, shh + b * b
+        while k < ends.size and ends[k] - 1 == i:
+            table[0, k], table[1, k], table[2, k], table[3, k], table[4, k] = sq, sqq, sh, sqh, shh
+            k += 1
+    return table
 
 
 def _first_least(values, tolerance):
