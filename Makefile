@@ -7,7 +7,7 @@ PYTHON ?= python3
 VENV ?= .venv
 BIN = $(VENV)/bin
 DEMO = build/demo
-SOURCES = setup.cfg pyproject.toml LICENSE README.md $(shell find rough sample_profiles -name '*.py' -o -name '*.tsv' -o -name '*.x3p')
+SOURCES = setup.cfg pyproject.toml LICENSE README.md $(shell find rough sample_profiles -name '*.py' -o -name '*.tsv' -o -name '*.x3p' -o -path '*/templates/*')
 
 .PHONY: demo demo-pipeline test lint format docs wheel install-wheel bench bench-run fuzz clean
 

@@ -26,6 +26,9 @@ html_theme = "furo"
 html_title = f"rough {release}"
 default_role = "code"
 nitpicky = False
+# Text is shown as written: smartquotes would turn the "--" of option names into en
+# dashes and the quotes of shell examples into curly ones, so pasted examples fail.
+smartquotes = False
 
 autodoc_default_options = {"members": False}
 autodoc_typehints = "none"

@@ -3,7 +3,9 @@ from . import experiment as experiment
 from . import fractal as fractal
 from . import io as io
 from . import metrology as metrology
+from . import plot as plot
 from . import render as render
+from . import reports as reports
 from . import tasks as tasks
 from .errors import InputError as InputError
 from .errors import RoughError as RoughError

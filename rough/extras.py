@@ -13,7 +13,7 @@ from .errors import RoughError
 DISTRIBUTION = "rough-metrology"
 # module -> (what needs it, the package on PyPI, the extra that installs it)
 EXTRAS = {
-    "matplotlib": ("--plot", "matplotlib", "plot"),
+    "matplotlib": ("figures (--plot, show, report)", "matplotlib", "plot"),
     "hidraw": ("the HID joystick", "hidapi", "haptics"),
     "hidtools": ("the HID joystick", "hid-tools", "haptics"),
     "evdev": ("an evdev force-feedback device", "evdev", "haptics"),
@@ -28,6 +28,8 @@ EXTRAS = {
     "rasterio": ("reading and writing GeoTIFF", "rasterio", "formats"),
     "tifffile": ("reading TIFF", "tifffile", "formats"),
     "distributed": ("--scheduler (a Dask cluster)", "distributed", "cluster"),
+    "jinja2": ("rough report", "Jinja2", "report"),
+    "weasyprint": ("a PDF report", "weasyprint", "report"),
 }
 
 

@@ -35,13 +35,15 @@ def check_size(shape, what):
         )
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class Units:
     """The units a surface's source file used for lateral and height values.
 
     Informational only: rough always holds metres, whatever the file used. Readers
     record the units they found; writers whose format carries them (``rough formats``
-    lists what each carries) pass them on.
+    lists what each carries) pass them on. A file that states no unit (NPY, a bare
+    column of numbers) is read in metres, or the unit given to the reader, and its
+    reader lists the axes in ``assumed``: ``rough info`` says so.
 
     Attributes
     ----------
@@ -49,6 +51,9 @@ class Units:
         The unit of lateral positions in the source file (``m``, ``mm``, ``um``, ...).
     z : str, default "m"
         The unit of heights in the source file.
+    assumed : tuple of str, default ()
+        The axes (``"xy"``, ``"z"``) whose unit the file does not state: the unit above
+        is the one rough was told or assumed (metres).
 
     Examples
     --------
@@ -60,10 +65,32 @@ class Units:
     Units(xy='mm', z='um')
     >>> round(float(scan.heights[0]) * 1e6, 6)  # µm
     1.5
+    >>> rough.read(b"0 1.5e-6\\n5e-4 -2e-6\\n1e-3 0.5e-6\\n").units
+    Units(xy='m', z='m', assumed=('xy', 'z'))
     """
 
     xy: str = "m"
     z: str = "m"
+    assumed: tuple = ()
+
+    def __repr__(self):
+        assumed = f", assumed={tuple(self.assumed)!r}" if self.assumed else ""
+        return f"Units(xy={self.xy!r}, z={self.z!r}{assumed})"
+
+    def description(self):
+        """The units as ``rough info`` and reports print them, saying which the file
+        did not state and in which unit its numbers were read.
+
+        >>> Units("mm", "um").description()
+        'xy mm, z um (as the file states)'
+        >>> Units(assumed=("z",)).description()
+        'xy m, z m (assumed: the source file stated no unit for z; numbers read z in m)'
+        """
+        line = f"xy {self.xy}, z {self.z}"
+        if not self.assumed:
+            return f"{line} (as the file states)"
+        read = ", ".join(f"{axis} in {getattr(self, axis)}" for axis in self.assumed)
+        return f"{line} (assumed: the source file stated no unit for {' or '.join(self.assumed)}; numbers read {read})"
 
 
 @dataclass(eq=False)

@@ -289,6 +289,7 @@ def _serve(task, channel, stdin):
     each index sent until None comes. It ends by ``os._exit``: nothing of the parent's
     (atexit, buffered output) runs twice."""
     status = 0
+    sys.unraisablehook = _stop_where_unraisable
     try:
         signal.pthread_sigmask(signal.SIG_UNBLOCK, _STOPPING)
         if stdin is not None:
@@ -310,6 +311,17 @@ def _serve(task, channel, stdin):
         status = 1
     finally:
         os._exit(status)
+
+
+def _stop_where_unraisable(unraisable):
+    """A worker's hook for an exception Python cannot raise (one in a finaliser or a
+    weakref callback, such as an import's lock): Ctrl-C or SIGTERM landing there ends
+    the worker at once and quietly, as anywhere else; other exceptions are printed as
+    Python prints them."""
+    if isinstance(unraisable.exc_value, Exception) or unraisable.exc_value is None:
+        sys.__unraisablehook__(unraisable)
+        return
+    os._exit(1)
 
 
 def one_thread():

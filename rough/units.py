@@ -23,6 +23,7 @@ METRES_PER_UNIT = {
     "μm": 1e-6,  # Greek mu U+03BC
     "nm": 1e-9,
     "pm": 1e-12,
+    "fm": 1e-15,
     "Å": 1e-10,
     "A": 1e-10,
     "in": 0.0254,
@@ -107,13 +108,94 @@ def parse_length(text, default_unit=None):
     return value
 
 
-_PREFIXES = [(1e3, "k"), (1.0, ""), (1e-3, "m"), (1e-6, "µ"), (1e-9, "n"), (1e-12, "p")]
+#: SI prefixes rough prints, as powers of a thousand: k (10³) down to f (10⁻¹⁵), for
+#: the amplitude coefficient C of a nanometre scan.
+_PREFIXES = {1: "k", 0: "", -1: "m", -2: "µ", -3: "n", -4: "p", -5: "f"}
+
+#: A number smaller than this fraction of the scale of its quantity is rounding
+#: noise (an origin of 6.4e-17 m on a 1 µm grid): it prints as 0.
+NOISE = 1e-9
+
+#: Each SI unit of a report row (docs/output.rst) → (power of the metre it scales
+#: with, how its label is written from a length symbol). A length power of 2 or 3 is
+#: written as a product of lengths, ``m3/m2`` (a volume per area) as ``µm³/µm²``.
+LENGTH_POWERS = {"m": 1, "m2": 2, "m3": 3, "m4": 4, "1/m": -1, "1/m2": -2, "m3/m2": 1, "m·%": 1}
+
+_SUPERSCRIPTS = {1: "", 2: "²", 3: "³", 4: "⁴"}
 
 
-def format_length(metres, digits=5):
+def scale_for(magnitude, unit):
+    """``(factor, label)``: multiply a value of about ``magnitude`` (in the SI ``unit``)
+    by ``factor`` to print it in ``label``, the prefixed unit in which the number
+    lies in [1, 1000) — one place for the text table, a column that shares one prefix
+    and a plot's axis.
+
+    ``unit`` is a report unit (``m``, ``m2``, ``m3``, ``1/m``, ``1/m2``, ``m3/m2``,
+    ``m·%``; see :data:`LENGTH_POWERS`) or any other SI symbol (``N``, ``Hz``), which
+    takes a plain prefix. A length is prefixed fm to km; an area or volume no single
+    prefix fits in [0.1, 1000) is a product of neighbouring ones (1e-9 m² is 1 mm·µm,
+    1000 µm², 0.001 mm²); a
+    frequency is per length (``/mm``), a density per area (``/mm²``). Zero, NaN and
+    infinities give the plain unit.
+
+    Examples
+    --------
+    >>> scale_for(2.5e-5, "m"), scale_for(4.3e-3, "1/m"), scale_for(1.48e-8, "m3/m2")
+    ((1000000.0, 'µm'), (1000.0, '/km'), (1000000000.0, 'nm³/nm²'))
+    >>> scale_for(2.5e-9, "m2"), scale_for(3.6e6, "1/m2"), scale_for(float("nan"), "m")
+    ((1000000000.0, 'mm·µm'), (1e-06, '/mm²'), (1.0, 'm'))
+    """
+    power = LENGTH_POWERS.get(unit, 1)
+    if not (magnitude and math.isfinite(magnitude)):
+        return 1.0, _label(unit, 0, power)
+    low, high = (-5 * power, power) if power > 0 else (power, -5 * power)
+    thousands = min(max(math.floor(math.log10(abs(magnitude)) / 3 + 1e-9), low), high)
+    thousands = _whole_power(thousands, magnitude, power, low, high)
+    return 10.0 ** (-3 * thousands), _label(unit, thousands, power)
+
+
+def _whole_power(thousands, magnitude, power, low, high):
+    """``thousands``, or a neighbour within ``low``…``high`` that is a whole number of
+    prefixes per length when the number stays in [0.1, 1000) with it: 0.42 /mm², not
+    420 /(m·mm)."""
+    for whole in (thousands, thousands + 1, thousands - 1):
+        if low <= whole <= high and whole % power == 0 and 0.1 <= abs(magnitude) / 10.0 ** (3 * whole) < 1000:
+            return whole
+    return thousands
+
+
+def _label(unit, thousands, power):
+    """The unit ``unit`` scaled by 1000**``thousands``, written with prefixes."""
+    if unit == "m3/m2":
+        symbol = _PREFIXES[thousands] + "m"
+        return f"{symbol}³/{symbol}²"
+    if unit == "m·%":
+        return _PREFIXES[thousands] + "m·%"
+    if unit not in LENGTH_POWERS:
+        return _PREFIXES.get(thousands, "") + unit
+    if power < 0:
+        denominator = _length_product(-thousands, -power)
+        return f"/({denominator})" if "·" in denominator else f"/{denominator}"
+    return _length_product(thousands, power)
+
+
+def _length_product(thousands, power):
+    """``power`` lengths whose prefixes add up to ``thousands``, as evenly as can be:
+    (-3, 2) → ``mm·µm``, (-4, 2) → ``µm²``, (-5, 3) → ``mm·µm²``."""
+    smaller, larger = divmod(thousands, power)
+    factors = [(smaller + 1, larger), (smaller, power - larger)]
+    return "·".join(f"{_PREFIXES[p]}m{_SUPERSCRIPTS[n]}" for p, n in factors if n)
+
+
+def format_length(metres, digits=5, scale=None):
     """A length with an SI-prefixed unit chosen so the number reads naturally:
-    ``format_length(7.728e-08)`` → ``'77.28 nm'``. NaN prints as ``'nan m'``."""
-    return format_si(metres, "m", digits)
+    ``format_length(7.728e-08)`` → ``'77.28 nm'``. NaN prints as ``'nan m'``; see
+    :func:`format_quantity` for ``scale``.
+
+    >>> format_length(7.728e-08), format_length(1e6), format_length(6.4e-17, scale=1e-6)
+    ('77.28 nm', '1000 km', '0 µm')
+    """
+    return _format(metres, "m", digits, scale)
 
 
 def digits_for(magnitude, resolution):
@@ -130,54 +212,68 @@ def digits_for(magnitude, resolution):
 
 def format_si(value, unit, digits=5):
     """``value`` (in the SI ``unit``) printed with a prefix: ``format_si(2.5e-5, 'm')``
-    → ``'25 µm'``. Zero, NaN and infinities print in the plain unit."""
-    if value == 0 or not math.isfinite(value):
-        return f"{value:.{digits}g} {unit}"
-    magnitude = abs(value)
-    scale, prefix = next(((s, p) for s, p in _PREFIXES if magnitude >= s * 0.9999995), _PREFIXES[-1])
-    return f"{value / scale:.{digits}g} {prefix}{unit}"
+    → ``'25 µm'``. Zero, NaN and infinities print in the plain unit.
+
+    >>> format_si(2.5e-5, "m"), format_si(1234.5, "N"), format_si(0, "Hz")
+    ('25 µm', '1.2345 kN', '0 Hz')
+    """
+    return _format(value, unit, digits)
 
 
-def format_quantity(value, unit, digits=5):
-    """A number with its unit for people: ``unit`` is ``m``, ``m2``, ``m3`` (SI prefix
-    chosen), ``1/m`` (printed per mm), ``1/m2`` (per mm²), ``m3/m2`` (a volume per
-    area, µm³/µm²), ``m·%`` (a height times a material ratio), ``1`` (a pure number),
-    ``%`` or ``deg``.
+def format_quantity(value, unit, digits=5, scale=None):
+    """A number with its unit for people, the number in [1, 1000) where a prefix can
+    make it so: ``unit`` is ``m``, ``m2``, ``m3``, ``1/m`` (printed per length,
+    ``/mm``), ``1/m2`` (per area), ``m3/m2`` (a volume per area: ``µm³/µm²``, the
+    prefix that fits), ``m·%`` (a height times a material ratio), ``1`` (a pure
+    number), ``%`` or ``deg``; :func:`scale_for` chooses the prefix. NaN and None
+    print as ``undefined``.
 
-    >>> format_quantity(2.5e-9, "m2"), format_quantity(3.6e6, "1/m2"), format_quantity(1.48e-8, "m3/m2")
-    ('0.0025 mm²', '3.6 /mm²', '0.0148 µm³/µm²')
+    ``scale`` is the size of the quantity in its context (a grid's spacing for an
+    origin): a value below :data:`NOISE` times it is rounding noise, printed as 0 in
+    the prefix of ``scale``.
+
+    >>> format_quantity(2.5e-9, "m2"), format_quantity(3.6e6, "1/m2"), format_quantity(1.48e-7, "m3/m2")
+    ('2.5 mm·µm', '3.6 /mm²', '148 nm³/nm²')
+    >>> format_quantity(4.3e-3, "1/m"), format_quantity(0.37, "1"), format_quantity(6.4e-17, "m", scale=1e-3)
+    ('4.3 /km', '0.37', '0 mm')
     """
     if value is None or (isinstance(value, float) and math.isnan(value)):
         return "undefined"
-    if unit == "m":
-        return format_length(value, digits)
-    if unit in _POWERS:
-        return _format_power(value, _POWERS[unit], digits)
-    if unit == "m3/m2":
-        return f"{value * 1e6:.{digits}g} µm³/µm²"  # = ml/m², the unit tribologists quote
-    if unit == "m·%":
-        return f"{format_length(value, digits)}·%"
-    if unit == "1/m":
-        return f"{value * 1e-3:.{digits}g} /mm"
-    if unit == "1/m2":
-        return f"{value * 1e-6:.{digits}g} /mm²"
     if unit == "%":
         return f"{value:.{digits}g} %"
     if unit == "deg":
         return f"{value:.{digits}g}°"
-    return f"{value:.{digits}g}"
+    if unit not in LENGTH_POWERS:
+        return f"{value:.{digits}g}"
+    return _format(value, unit, digits, scale)
 
 
-_POWERS = {"m2": 2, "m3": 3}
+def format_range(low, high, unit, digits=4):
+    """``low to high`` in ``unit`` (as :func:`format_quantity`), in one prefix when it
+    fits both (the smaller at least 0.1), else each in its own.
+
+    >>> format_range(100.0, 2e4, "1/m"), format_range(4.3e-3, 2e4, "1/m")
+    ('0.1 to 20 /mm', '4.3 /km to 20 /mm')
+    """
+    largest = max(abs(low), abs(high))
+    factor, label = scale_for(largest, unit)
+    if abs(float(f"{largest * factor:.{digits}g}")) >= 1000:  # rounds up to the next prefix
+        factor, label = scale_for(largest * 1.001, unit)
+    if unit in LENGTH_POWERS and all(math.isfinite(v) and (v == 0 or abs(v * factor) >= 0.1) for v in (low, high)):
+        return f"{low * factor:.{digits}g} to {high * factor:.{digits}g} {label}"
+    return f"{format_quantity(low, unit, digits)} to {format_quantity(high, unit, digits)}"
 
 
-def _format_power(value, power, digits):
-    """An area or volume in the largest prefix that leaves at least a thousandth:
-    2.5e-9 m² → 0.0025 mm², 7.8e-7 m² → 0.78 mm², 2.5e-13 m² → 0.25 µm²."""
-    if value == 0 or not math.isfinite(value):
-        return f"{value:.{digits}g} m{'²³'[power - 2]}"
-    scale, prefix = next(((s, p) for s, p in _PREFIXES if abs(value) >= 1e-3 * s**power), _PREFIXES[-1])
-    return f"{value / scale**power:.{digits}g} {prefix}m{'²³'[power - 2]}"
+def _format(value, unit, digits, scale=None):
+    """``value`` in ``unit`` with the prefix :func:`scale_for` gives for it (for
+    ``scale`` when it is noise, or zero): one prefix up when rounding makes it 1000."""
+    if scale is not None and abs(value) < NOISE * abs(scale):
+        value = 0.0
+    magnitude = abs(value) if value or scale is None else abs(scale)
+    factor, label = scale_for(magnitude, unit)
+    if abs(float(f"{value * factor:.{digits}g}")) >= 1000:
+        factor, label = scale_for(magnitude * 1.001, unit)
+    return f"{value * factor:.{digits}g} {label}"
 
 
 _FREQUENCY = re.compile(

@@ -14,11 +14,12 @@ from rough import Surface
 from rough.fractal.filling import fill_invalid
 from rough.fractal.fit import fit_fractal
 from rough.fractal.scaling import TOLERANCE, departure, fit_spectrum, profile_bins
+from rough.units import parse_frequency
 
 from conftest import shared_data_path
 from fbm import fbm
 
-HINTED_BAND = re.compile(r"--band ([0-9.e+-]+)/mm:([0-9.e+-]+)/mm")
+HINTED_BAND = re.compile(r"--band ([^\s:)]+):([^\s:)]+)")  # as --band takes it: 33.47/km:226.5/km
 
 
 def drifting(n, drift, rng):
@@ -114,7 +115,7 @@ def test_hints_never_loop():
     for name, surface in awkward_inputs():
         fit, steps = fit_fractal(surface), 0
         while (match := HINTED_BAND.search(fit.hint or "")) and steps < 3:
-            fit = fit_fractal(surface, band=(float(match.group(1)) * 1e3, float(match.group(2)) * 1e3))
+            fit = fit_fractal(surface, band=tuple(map(parse_frequency, match.groups())))
             steps += 1
             assert fit.verdict in ("power law", "at bound"), name
             assert fit.band_rule == "given"

@@ -91,7 +91,7 @@ def test_north_up_dem_is_flipped_so_row_0_is_south(name):
     assert scan.metadata["crs"] == "EPSG:3794"  # Slovene National Grid, exactly
     assert scan.metadata["geotiff_transform"] == "1.0, 0.0, 563999.5, 0.0, -1.0, 146999.5"
     assert scan.metadata["geotiff_area_or_point"] == "Area"
-    assert scan.units == rough.Units("m", "m")
+    assert scan.units == rough.Units("m", "m", ("z",))  # xy in the CRS's metres; the band names no unit
     expected = facts.get("descriptive", described)
     invalid = int(np.isnan(z).sum())
     assert invalid == facts.get("nb_nodata_pixels", 0)

@@ -65,7 +65,7 @@ def commands(group=cli, path=()):
 
 def numeric_options(command):
     for parameter in command.params:
-        if isinstance(parameter, click.Option) and not parameter.is_flag:
+        if isinstance(parameter, click.Option) and not parameter.is_flag and not parameter.count:
             if not isinstance(parameter.type, NOT_NUMBERS):
                 yield parameter
 
@@ -138,6 +138,7 @@ BASES = {
     ("rose",): ["{map}", "--json"],
     ("map",): ["{map}", "--window", "16px", "--parameters", "Sq,hurst", "--json"],
     ("render",): ["{map}", "--duration", "20ms", "--json"],
+    ("report",): ["{profile}", "-o", "-"],
     ("synth",): ["--size", "32x32", "--step", "2um", "--dimension", "2.3", "--rq", "1um", "-o", "{out}"],
     ("experiment", "design"): ["{folder}", "--reference", "1.275,0.2781mm", "--subjects", "1", "--seed", "1"],
     ("experiment", "run"): ["{study}", "--subject", "S01", "--observer", OBSERVER, "--stroke", "0.2s"],

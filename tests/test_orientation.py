@@ -465,9 +465,9 @@ def north_up_geotiff(path, rows_from_north, spacing=1.0):
 def drawn(surface):
     """The map of ``rough show`` as pixels (grey levels, row 0 at the top of the page) and its axes."""
     pytest.importorskip("matplotlib")
-    from rough import plots
+    from rough import plot
 
-    figure = plots.surface_figure(surface, colormap="gray")
+    figure = plot.surface_figure(surface, colormap="gray")
     figure.canvas.draw()
     axes = figure.axes[0]
     box = axes.get_window_extent()

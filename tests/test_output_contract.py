@@ -1,9 +1,11 @@
 """The output contract (docs/output.rst) over every command that reports: --json is one
 object naming its input with a list of warnings, --tsv rows are file, key, value, unit
-with plain values, every TSV key is a path into the JSON with the same value, and the
-text table uses the same keys (apart from the labelled rows of per-angle and per-run
-tables). Several inputs give JSON Lines or one TSV table, going on past a bad file."""
+with a number or nothing as value (text in the last column), every TSV key is a path
+into the JSON with the same value, and the text table uses the same keys (apart from
+the labelled rows of per-angle and per-run tables). Several inputs give JSON Lines or
+one TSV table, going on past a bad file."""
 
+import io
 import json
 import math
 import re
@@ -16,7 +18,6 @@ from rough import sample
 
 PROFILE = str(sample("rock-profile.tsv"))
 MAP = str(sample("rock-map.x3p"))
-NUMERIC_UNITS = {"m", "1/m", "1", "N", "s", "Hz", "deg", "points", "m^(3-β)", "m^(4-α)", "1/mm", "1/unit of D"}
 # text rows labelled for people (tables), each documented in docs/output.rst
 LABELLED = re.compile(
     r"^(θ =.*|\S+mm_s\.\S+|variable|answers|likelihood ratio|log-likelihood|fractal dimension D|Rq \(per mm\)"
@@ -68,14 +69,15 @@ def resolve(document, key):
     return document
 
 
-def same(cell, value):
+def same(cell, last, value):
+    """Whether the TSV cells ``cell`` (value) and ``last`` (unit or text) hold ``value``:
+    a number in the value column (``nan`` for null), anything else as text in the last
+    with no value."""
     if value is None:
-        return cell == ""
-    if isinstance(value, bool):
-        return cell == str(value).lower()
-    if isinstance(value, (int, float)):
+        return cell == "nan"
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
         return cell != "" and math.isclose(float(cell), value, rel_tol=0, abs_tol=0)
-    return cell == str(value)
+    return cell == "" and last == (str(value).lower() if isinstance(value, bool) else str(value))
 
 
 def check(args, file):
@@ -92,9 +94,9 @@ def check(args, file):
         name, key, value, unit = cells
         assert name == file
         assert not value.startswith("np."), line
-        if unit in NUMERIC_UNITS and value:
-            float(value)  # plain numbers only
-        assert same(value, resolve(document, key)), (line, resolve(document, key))
+        if value:
+            float(value)  # numbers only
+        assert same(value, unit, resolve(document, key)), (line, resolve(document, key))
         keys.add(key)
     text = rough(*args).stdout.decode().splitlines()
     assert text[0].split()[0] == "file"
@@ -119,8 +121,8 @@ def check_formats():
     document = json.loads(rough("formats", "--json").stdout)
     assert document["file"] is None and document["warnings"] == []
     for line in rough("formats", "--tsv").stdout.decode().splitlines():
-        name, key, value, _ = line.split("\t")
-        assert name == "" and same(value, resolve(document, key))
+        name, key, value, last = line.split("\t")
+        assert name == "" and same(value, last, resolve(document, key))
 
 
 def test_experiment_reports_keep_the_contract(study):
@@ -208,3 +210,29 @@ def test_side_file_names_take_the_inputs_stem():
     assert stem_name("plots/{stem}.png", "scans/a.b.x3p") == "plots/a.b.png"
     assert stem_name("{stem}.png", "scans/.hidden.x3p") == ".hidden.png"
     assert stem_name("{name}.json", "-") == "stdin.json"
+
+
+def test_an_undefined_number_is_nan_and_only_a_text_row_has_no_value(tmp_path):
+    flat = tmp_path / "flat.tsv"
+    flat.write_text("".join(f"{i * 1e-3} 0\n" for i in range(100)))
+    rows = {
+        line.split("\t")[1]: line.split("\t")[2:]
+        for line in rough("features", "--tsv", str(flat)).stdout.decode().splitlines()
+    }
+    assert rows["Rsk"] == ["nan", "1"]
+    units = {
+        line.split("\t")[1]: line.split("\t")[2:]
+        for line in rough("info", "--tsv", str(flat)).stdout.decode().splitlines()
+    }
+    assert units["units.xy"] == ["", "m"] and units["format"] == ["", "tsv"]
+    pandas = pytest.importorskip("pandas")
+    table = pandas.read_csv(
+        io.BytesIO(rough("features", "--tsv", str(flat)).stdout),
+        sep="\t",
+        names=["file", "key", "value", "unit"],
+        keep_default_na=False,
+    )
+    numbers = table[table["value"] != ""].astype({"value": float})  # docs/output.rst's recipe
+    wide = numbers.pivot(index="file", columns="key", values="value")
+    assert math.isnan(wide["Rsk"].iloc[0]) and wide["Rq"].iloc[0] == 0
+    assert "evaluation.basis" not in wide

@@ -104,3 +104,24 @@ def test_the_makefile_recipe_makes_one_table(workdir, tmp_path):
     rows = [line.split("\t") for line in (tmp_path / "features.tsv").read_text().splitlines()]
     assert {row[0] for row in rows} == {"scans/rock-map.x3p", "scans/profile.x3p"}
     assert all(len(row) == 4 for row in rows)
+
+
+def test_the_pandas_recipe_gives_numbers(workdir, tmp_path, monkeypatch):
+    """The recipe of "Many files at once" on a real table: ``Sa`` comes out numeric even
+    though text-valued rows (``evaluation.basis``, ``format``) share the table."""
+    pandas = pytest.importorskip("pandas", reason="pandas is not installed (rough does not need it)")
+    recipe = re.search(r"```python\n(import pandas.*?)```", section("Many files at once"), re.S).group(1)
+    sample = ROOT / "sample_profiles"
+    scans = [sample / "rock-map.x3p", sample / "rock-profile.tsv", tmp_path / "map.x3p"]
+    synth = ["rough", "synth", "--size", "64x48", "--step", "10um", "--dimension", "2.3", "--rq", "1um", "--seed", "1"]
+    subprocess.run([*synth, "-o", scans[2]], env=environment(), check=True)
+    with open(tmp_path / "features.tsv", "w") as table:
+        subprocess.run(["rough", "features", "--tsv", *scans], env=environment(), stdout=table, check=True)
+    *lines, last = recipe.strip().splitlines()
+    namespace = {}
+    monkeypatch.chdir(tmp_path)
+    exec("\n".join(lines), namespace)
+    mean = eval(last, namespace)
+    wide = namespace["wide"]
+    assert pandas.api.types.is_float_dtype(wide["Sa"]) and isinstance(mean, float)
+    assert wide["Sa"].count() == 2 and 0 < mean < 1e-3  # two maps; metres

@@ -185,7 +185,7 @@ def test_summary_without_output(tmp_path, run):
         (("--window", "128px"), "larger than the map"),
         (("--window", "8px"), "at least 16"),
         (("--window", "32px", "--parameters", "Sq,Sfoo"), "known: Sa, Sq"),
-        (("--window", "32px", "-o", "{out}.png"), "cannot tell the format"),
+        (("--window", "32px", "-o", "{out}.png"), "cannot write a surface as .png"),
         (("--window", "32px", "--parameters", "Sq,Ssk", "-o", "{out}.x3p"), "only GeoTIFF"),
         (("--window", "32"), "256px"),
     ],

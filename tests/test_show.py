@@ -1,4 +1,4 @@
-"""rough show and the figures of rough.plots: the map at its true aspect, invalid
+"""rough show and the figures of rough.plot: the map at its true aspect, invalid
 points marked, the file name in the title, the output contract; the percentage
 figure's n and Wilson error bars."""
 
@@ -21,7 +21,7 @@ from conftest import rough as run_rough
 
 pytest.importorskip("matplotlib")
 
-from rough import plots  # noqa: E402 -- after the skip: plots needs matplotlib
+from rough import plot  # noqa: E402 -- after the skip: plot needs matplotlib
 
 PNG = b"\x89PNG\r\n\x1a\n"
 MAP = rough.sample("rock-map.x3p")
@@ -171,15 +171,15 @@ def test_without_matplotlib_one_line_before_reading(tmp_path):
 
 def test_surface_figure_follows_the_extent():
     strip = synthesize_map((1000, 100), (10e-6, 10e-6), 2.3, rq=2e-6, seed=4)  # 10 mm × 1 mm
-    assert image_ratio(plots.surface_figure(strip)) == pytest.approx(10, rel=0.02)
+    assert image_ratio(plot.surface_figure(strip)) == pytest.approx(10, rel=0.02)
     # unequal spacing: 100 × 100 points, 10 µm × 40 µm apart, is four times taller than wide
     tall = rough.Surface(np.random.default_rng(5).normal(size=(100, 100)) * 1e-7, spacing=(10e-6, 40e-6))
-    assert image_ratio(plots.surface_figure(tall)) == pytest.approx(0.25, rel=0.02)
+    assert image_ratio(plot.surface_figure(tall)) == pytest.approx(0.25, rel=0.02)
 
 
 def test_features_figure_draws_maps_at_their_aspect_too(strip):
     surface = rough.read(strip)
-    figure = plots.features_figure(surface, (), metrology.amplitude_density(surface), title="strip.x3p")
+    figure = plot.features_figure(surface, (), metrology.amplitude_density(surface), title="strip.x3p")
     assert image_ratio(figure) == pytest.approx(20, rel=0.02)
     assert "strip.x3p" in texts(figure)
 
@@ -188,11 +188,11 @@ def test_invalid_points_are_counted_and_grey():
     from matplotlib.colors import to_rgba
 
     scan = rough.read(MAP)
-    figure = plots.surface_figure(scan, title="rock-map.x3p")
+    figure = plot.surface_figure(scan, title="rock-map.x3p")
     assert figure.get_suptitle() == "rock-map.x3p"
     assert "invalid (NaN): 6 points" in texts(figure)
     image = figure.axes[0].get_images()[0]
-    assert tuple(image.get_cmap().get_bad()) == pytest.approx(to_rgba(plots.INVALID_COLOUR))
+    assert tuple(image.get_cmap().get_bad()) == pytest.approx(to_rgba(plot.INVALID_COLOUR))
     assert figure.axes[0].get_xlabel() == "x (mm)" and figure.axes[1].get_ylabel() == "height (µm)"
     assert "1 mm" in texts(figure)  # the scale bar, a fifth of 6.4 mm or less
 
@@ -213,7 +213,7 @@ def test_maps_are_drawn_with_y_upwards(hillshade):
     y, x = np.mgrid[0:60, 0:80]
     bump = 1e-6 * np.exp(-((x - 60) ** 2 + (y - 45) ** 2) / 30.0)
     scan = rough.Surface(bump, spacing=10e-6, origin=(0.0, 1e-3))
-    figure = plots.surface_figure(scan, colormap="gray", hillshade=hillshade)
+    figure = plot.surface_figure(scan, colormap="gray", hillshade=hillshade)
     assert figure.axes[0].get_ylabel() == "y (µm)"
     assert figure.axes[0].get_ylim() == pytest.approx((995, 1595))  # y0 − dy/2 to y0 + 60 dy − dy/2
     image = page(figure)
@@ -229,7 +229,7 @@ def test_maps_are_drawn_with_y_upwards(hillshade):
 
 def test_units_follow_the_sizes():
     small = rough.Surface(np.random.default_rng(6).normal(size=(64, 64)) * 5e-9, spacing=1e-6)  # 64 µm, nm heights
-    figure = plots.surface_figure(small)
+    figure = plot.surface_figure(small)
     assert figure.axes[0].get_xlabel() == "x (µm)" and figure.axes[1].get_ylabel() == "height (nm)"
     assert "10 µm" in texts(figure)
     assert figure.get_suptitle() == "surface"
@@ -238,7 +238,7 @@ def test_units_follow_the_sizes():
 def test_a_profile_with_gaps():
     heights = np.sin(np.linspace(0, 20, 2000)) * 1e-6
     heights[500:600] = np.nan
-    figure = plots.surface_figure(rough.Surface(heights, spacing=1e-6), title="gaps")
+    figure = plot.surface_figure(rough.Surface(heights, spacing=1e-6), title="gaps")
     assert "invalid (NaN): 100 points" in texts(figure)
     line = figure.axes[0].get_lines()[0]
     assert np.isnan(line.get_ydata()[500:600]).all()  # a gap, not a line drawn across
@@ -248,7 +248,7 @@ def test_a_profile_with_gaps():
 def test_a_spike_does_not_wash_out_the_colours():
     heights = np.random.default_rng(7).normal(size=(100, 100)) * 1e-6
     heights[3, 3] = 1e-3
-    figure = plots.surface_figure(rough.Surface(heights, spacing=1e-6))
+    figure = plot.surface_figure(rough.Surface(heights, spacing=1e-6))
     bar = figure.axes[1]
     assert bar.get_ylim()[1] < 10  # µm, not 1000
     assert "1 points beyond the arrows" in bar.get_ylabel()
@@ -256,11 +256,11 @@ def test_a_spike_does_not_wash_out_the_colours():
 
 def test_every_figure_shares_the_style():
     scan = rough.read(MAP)
-    figure = plots.surface_figure(rough.read(PROFILE))
+    figure = plot.surface_figure(rough.read(PROFILE))
     assert figure.axes[0].xaxis.get_gridlines()[0].get_visible()  # the style's grid
     assert figure.get_layout_engine() is not None
-    assert plots.surface_figure(scan).axes[0].get_images()  # maps: no grid over the image
-    assert not plots.surface_figure(scan).axes[0].xaxis.get_gridlines()[0].get_visible()
+    assert plot.surface_figure(scan).axes[0].get_images()  # maps: no grid over the image
+    assert not plot.surface_figure(scan).axes[0].xaxis.get_gridlines()[0].get_visible()
 
 
 # -- the shared data: real instruments ----------------------------------------------------------------
@@ -268,7 +268,7 @@ def test_every_figure_shares_the_style():
 
 def test_a_real_scan_with_invalid_points(shared_data, tmp_path):
     path = shared_data / "x3ptools" / "sample-land.x3p"  # 918 × 256, 25292 NaN
-    figure = plots.surface_figure(rough.read(path), title=path.name)
+    figure = plot.surface_figure(rough.read(path), title=path.name)
     assert "invalid (NaN): 25,292 points" in texts(figure)
     assert image_ratio(figure) == pytest.approx(918 / 256, rel=0.02)
     out = tmp_path / "land.png"
@@ -279,7 +279,7 @@ def test_a_real_scan_with_invalid_points(shared_data, tmp_path):
 
 def test_a_real_scan_with_unequal_spacing(shared_data, tmp_path):
     path = shared_data / "SurfaceTopography" / "x3p-2.x3p"  # 650 × 650 points, 83 µm × 204 µm
-    figure = plots.surface_figure(rough.read(path), title=path.name)
+    figure = plot.surface_figure(rough.read(path), title=path.name)
     assert image_ratio(figure) == pytest.approx(8.29767313942749e-5 / 2.044783737930349e-4, rel=0.02)
     assert figure.axes[0].get_xlabel() == "x (µm)"
     out = tmp_path / "x3p-2.png"
@@ -311,7 +311,7 @@ def test_percentage_figure_has_n_and_wilson_error_bars(answered):
     from rough.experiment.analysis import percentages
 
     cells = percentages(answered, 1)
-    figure = plots.percentage_figure(answered, [1], title="study")
+    figure = plot.percentage_figure(answered, [1], title="study")
     axes = figure.axes[0]
     bars = [c for c in axes.containers if isinstance(c, BarContainer)]
     errors = [c for c in axes.containers if isinstance(c, ErrorbarContainer)]
@@ -319,7 +319,7 @@ def test_percentage_figure_has_n_and_wilson_error_bars(answered):
     assert len(bars) == len(errors) == len(cells) == 8
     assert sorted(label.split("n = ")[1] for label in labels) == sorted(str(c[4]) for c in cells)
     for (_, _, _, percent, answers), error in zip(cells, errors):
-        low, high = plots.proportion_interval(round(percent * answers / 100), answers)
+        low, high = plot.proportion_interval(round(percent * answers / 100), answers)
         segment = error.lines[2][0].get_segments()[0]  # the vertical bar: (x, low), (x, high)
         assert segment[0][1] == pytest.approx(100 * low) and segment[1][1] == pytest.approx(100 * high)
     assert figure.get_suptitle() == "study"
@@ -328,19 +328,19 @@ def test_percentage_figure_has_n_and_wilson_error_bars(answered):
 def test_the_wilson_interval_without_statsmodels(monkeypatch):
     pytest.importorskip("statsmodels")
     cases = [(0, 3), (1, 3), (6, 8), (8, 8), (17, 40)]
-    expected = [plots.proportion_interval(k, n) for k, n in cases]
+    expected = [plot.proportion_interval(k, n) for k, n in cases]
     monkeypatch.setitem(sys.modules, "statsmodels.stats.proportion", None)  # import fails
     for (k, n), interval in zip(cases, expected):
-        assert plots.proportion_interval(k, n) == pytest.approx(interval, abs=1e-12)
+        assert plot.proportion_interval(k, n) == pytest.approx(interval, abs=1e-12)
     # Wilson (1927) for 6 of 8 at 95 %: 0.4093 to 0.9285
-    assert plots.proportion_interval(6, 8) == pytest.approx((0.40927, 0.92849), abs=1e-4)
+    assert plot.proportion_interval(6, 8) == pytest.approx((0.40927, 0.92849), abs=1e-4)
 
 
 def test_the_plots_stub_loads_matplotlib_only_to_draw():
     code = (
-        "import sys; from rough import plots; "
-        "print('matplotlib' in sys.modules, plots.length_unit(6.4e-3), plots.proportion_interval(6, 8)[0] > 0.4); "
-        "plots.surface_figure; print('matplotlib' in sys.modules)"
+        "import sys; from rough import plot; "
+        "print('matplotlib' in sys.modules, plot.length_unit(6.4e-3), plot.proportion_interval(6, 8)[0] > 0.4); "
+        "plot.surface_figure; print('matplotlib' in sys.modules)"
     )
     env = {**os.environ, "PYTHONPATH": str(pathlib.Path(rough.__file__).parent.parent)}
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, env=env, check=True)
@@ -348,6 +348,6 @@ def test_the_plots_stub_loads_matplotlib_only_to_draw():
 
 
 def test_no_plots_module_shadows_a_public_name():
-    modules = {path.stem for path in pathlib.Path(plots.__file__).parent.glob("*.py")}
-    assert not modules & set(plots.__all__)
-    assert all(getattr(plots, name) is not None for name in plots.__all__)
+    modules = {path.stem for path in pathlib.Path(plot.__file__).parent.glob("*.py")}
+    assert not modules & set(plot.__all__)
+    assert all(getattr(plot, name) is not None for name in plot.__all__)

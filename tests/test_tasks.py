@@ -93,6 +93,28 @@ def test_a_dead_worker_raises_a_rough_error():
         list(tasks.map_ordered(dies, range(4), jobs=2))
 
 
+class _InterruptedWhenCollected:
+    def __del__(self):
+        raise KeyboardInterrupt  # as Ctrl-C landing in a finaliser: Python cannot raise it
+
+
+@forking
+def test_a_stop_where_python_cannot_raise_it_ends_the_worker_quietly(capfd):
+    """Ctrl-C or SIGTERM that lands in a finaliser or a weakref callback (an import's
+    lock) ends the worker, printing nothing ("Exception ignored in …" was printed and
+    the worker went on)."""
+
+    def interrupted(item):
+        if item == 1:
+            _InterruptedWhenCollected()
+            time.sleep(30)  # not reached: the worker ends as the object is collected
+        return item
+
+    with pytest.raises(rough.RoughError, match="worker process died"):
+        list(tasks.map_ordered(interrupted, range(4), jobs=2))
+    assert "Exception ignored" not in capfd.readouterr().err
+
+
 @forking
 def test_keyboard_interrupt_in_the_consumer_stops_the_workers():
     seen = []

@@ -19,7 +19,7 @@ from hypothesis import strategies as st
 
 import rough
 from rough.errors import InputError
-from rough.io import open_surface, open_tiles, read, registry
+from rough.io import open_surface, open_tiles, read, registry, x3pdata
 
 from conftest import ROOT
 
@@ -294,6 +294,29 @@ def test_x3p_checksums_are_checked_when_opened(tmp_path, compression, caplog):
         tiled = open_tiles(path, verify=False)
     assert "checksum mismatch" in caplog.text
     same(tiled, read(path, verify=False))
+
+
+@pytest.mark.parametrize("compression", [zipfile.ZIP_STORED, zipfile.ZIP_DEFLATED], ids=["stored", "deflated"])
+def test_open_surface_checks_the_data_once(tmp_path, compression, monkeypatch):
+    """A map that fits the budget is checked by its whole read alone (no second pass
+    over the data member); one read in tiles is checked once, before its first tile;
+    and a damaged one is refused either way."""
+    path = x3p(tmp_path / "map.x3p", heights(), compression=compression)
+    passes = []
+    digests = x3pdata._member_digests
+    monkeypatch.setattr(x3pdata, "_member_digests", lambda *a: passes.append(1) or digests(*a))
+    assert isinstance(open_surface(path), rough.Surface) and passes == []
+    assert isinstance(open_surface(path, memory=1000), rough.io.TiledSurface) and passes == [1]
+    with zipfile.ZipFile(path) as archive:
+        members = {name: archive.read(name) for name in archive.namelist()}
+    damaged = bytearray(members["bindata/data.bin"])
+    damaged[-8] ^= 1
+    with zipfile.ZipFile(path, "w") as archive:
+        for name, content in members.items():
+            archive.writestr(name, bytes(damaged) if name == "bindata/data.bin" else content, compress_type=compression)
+    for memory in (None, 1000):
+        with pytest.raises(InputError, match=r"map\.x3p: bindata/data\.bin checksum mismatch"):
+            open_surface(path, memory=memory)
 
 
 def test_damaged_and_cut_short_x3p_are_refused(tmp_path):

@@ -13,7 +13,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import rough
-import rough.plots
+import rough.plot
 from rough.fractal.filling import fill_invalid
 from rough.fractal.psd import binned_spectrum
 
@@ -93,6 +93,6 @@ print(f"band {low * 1e-3:.3g} to {high * 1e-3:.3g} /mm")
 # it), and Ds has a standard error of a few hundredths.
 
 spectrum = binned_spectrum(filled)
-fig = rough.plots.spectrum_figure(
+fig = rough.plot.spectrum_figure(
     np.array(spectrum["frequency"]), np.array(spectrum["density"]), fit, filled.spacing, title="rock-map.x3p"
 )

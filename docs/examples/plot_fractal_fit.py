@@ -21,7 +21,7 @@ Fisher information.
 import numpy as np
 
 import rough
-import rough.plots
+import rough.plot
 from rough.fractal.psd import binned_spectrum
 
 profile = rough.read(rough.sample("rock-profile.tsv"))
@@ -50,14 +50,14 @@ print(f"sampling model: {fit.sampling}")
 # -------------------------------------
 #
 # The Hann-windowed periodogram of the levelled profile, averaged in logarithmic
-# bins, with the fitted G(f) over its band (``rough.plots.spectrum_figure`` draws
+# bins, with the fitted G(f) over its band (``rough.plot.spectrum_figure`` draws
 # the figure of ``rough fit-fractal --plot``). The lowest two or three bins fall below
 # the line: removing the line and applying the window take power out of wavelengths
 # comparable with the profile's length. The fit works on the differences, which need no
 # window, and is not biased there.
 
 spectrum = binned_spectrum(profile)
-fig = rough.plots.spectrum_figure(
+fig = rough.plot.spectrum_figure(
     np.array(spectrum["frequency"]),
     np.array(spectrum["density"]),
     fit,

@@ -16,7 +16,7 @@ import math
 import matplotlib.pyplot as plt
 
 import rough
-import rough.plots
+import rough.plot
 
 # %%
 # An anisotropic fractal map
@@ -83,7 +83,7 @@ print(f"ISO 25178-2: Str = {result.Str:.3f}, Std = {result.Std:.1f}°")
 # is the principal wavevector, the dashed one the lay. This is the figure that
 # ``rough rose --plot`` draws.
 
-fig = rough.plots.rose_figure(result, title="anisotropic fractal map")
+fig = rough.plot.rose_figure(result, title="anisotropic fractal map")
 
 # %%
 # The χ² tests compare the sectors with a constant Ds and C; p-values this small (0 is

@@ -12,6 +12,12 @@ as with one: each worker keeps its input's log lines, warnings, report and error
 and sends them back, so that standard output and standard error read as they would
 one input after another. Side files and ``-o`` outputs are written by the workers
 (on a cluster, to the file system they share with this machine).
+
+A warning that an earlier input gave already (:func:`warning_template`: the same text
+but for the input's name and the numbers) is printed once and counted: at the end one
+line per such warning says for how many more files it came, naming the first three,
+with ``…`` for each number that differs between them (:func:`shared_text`). Each input's ``--json``
+document keeps all of its warnings.
 """
 
 import contextlib
@@ -19,13 +25,14 @@ import dataclasses
 import functools
 import logging
 import os
+import re
 import sys
 import warnings
 
 import click
 
 from .. import errors, io, progress, tasks
-from .main import _warn_in_one_line, current_input, failure, say
+from .main import _warn_in_one_line, current_input, failure, note, say
 from .report import Printer, collected_warnings
 
 log = logging.getLogger("rough")
@@ -66,17 +73,97 @@ def run_each(work, names, options):
         if jobs > 1:
             return _in_parallel(work, names, options, side, printer, jobs=jobs)
     status = 0
-    for name in _progress(names, many):
-        report, warnings, failed = _one(work, name, _named(options, side, name), many)
-        status = max(status, failed)
-        if report is not None:
-            printer.print(report, name, warnings)
+    with _repeats_counted(many):
+        for name in _progress(names, many):
+            report, warnings, failed = _one(work, name, _named(options, side, name), many)
+            status = max(status, failed)
+            if report is not None:
+                printer.print(report, name, warnings)
     return status
+
+
+#: Numbers in a warning's text (counts, sizes, positions), which :func:`warning_template` leaves out.
+NUMBER = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?")
+
+
+def warning_template(message, name):
+    """What makes two inputs' warnings "the same": ``message`` without the input's
+    ``name`` and with every number written ``#``.
+
+    >>> warning_template("a.x3p: 12 of 4096 points are NaN (0.29 %)", "a.x3p")
+    ': # of # points are NaN (# %)'
+    """
+    return NUMBER.sub("#", message.replace(name, "") if name else message)
+
+
+class _Repeats(logging.Filter):
+    """Lets through a warning the first time it comes (:func:`warning_template`) and
+    the warnings of that same input; counts the later inputs that repeat it."""
+
+    def __init__(self):
+        super().__init__()
+        self.first = {}  # template -> (the first input's message, that input)
+        self.later = {}  # template -> {later input: its message without its name}, in order
+
+    def filter(self, record):
+        if record.levelno != logging.WARNING or not current_input:
+            return True
+        name, message = current_input[0], record.getMessage()
+        template = warning_template(message, name)
+        if self.first.setdefault(template, (message, name))[1] == name:
+            return True
+        self.later.setdefault(template, {})[name] = message.replace(name, "")
+        return False
+
+    def summary(self):
+        """One line per repeated warning: how many more files gave it (the first three
+        named), and its text with ``…`` for each number that differs between them."""
+        for template, later in self.later.items():
+            message, name = self.first[template]
+            files = [str(file) for file in later]
+            named = ", ".join(files[:3]) + (", …" if len(files) > 3 else "")
+            text = shared_text([message.replace(name, ""), *later.values()]).lstrip(": ")
+            yield f"the same warning for {len(files)} more file{'s' if len(files) > 1 else ''} ({named}): {text}"
+
+
+def shared_text(messages):
+    """The text of ``messages`` that share a :func:`warning_template`, with ``…`` for
+    each number that is not the same in all of them.
+
+    >>> shared_text(["Str < 0.673 at 10 %", "Str < 0.783 at 10 %"])
+    'Str < … at 10 %'
+    """
+    numbers = [[match.group() for match in NUMBER.finditer(message)] for message in messages]
+    shown = iter(values[0] if len(set(values)) == 1 else "…" for values in zip(*numbers))
+    return NUMBER.sub(lambda match: next(shown), messages[0])
+
+
+@contextlib.contextmanager
+def _repeats_counted(many):
+    """With several inputs, the handlers on standard error print a repeated warning
+    once; the summary of the repeats follows the work."""
+    if not many:
+        yield
+        return
+    repeats, handlers = _Repeats(), list(log.handlers)
+    for handler in handlers:
+        handler.addFilter(repeats)
+    try:
+        yield
+    finally:
+        for handler in handlers:
+            handler.removeFilter(repeats)
+    for line in repeats.summary():
+        say(line)
 
 
 def read_named(name, options):
     """The surface in input ``name`` (see :func:`rough.io.read`); with a ``memory``
-    option, a tiled one when it is too large for it (:func:`rough.io.open_surface`)."""
+    option, a tiled one when it is too large for it (:func:`rough.io.open_surface`).
+    Standard input on a terminal is announced first: nothing else says why the command
+    waits."""
+    if name == "-" and io.is_terminal(sys.stdin):
+        note("reading a surface from standard input (end with Ctrl-D; give a FILE to read a file)")
     if "memory" in options:
         return io.open_surface(name, **options)
     return io.read(name, **options)
@@ -144,6 +231,7 @@ def _in_parallel(work, names, options, side, printer, jobs=1, scheduler=None):
     items = [(name, _named(options, side, name)) for name in names]
     status = 0
     with (
+        _repeats_counted(len(names) > 1),
         progress.progress(total=len(names), description="files", unit="file") as bar,
         contextlib.closing(
             tasks.outcomes(task, items, jobs=jobs, scheduler=scheduler, finished=lambda: bar.update(1))

@@ -3,7 +3,7 @@
 import click
 
 from ..io import registry
-from .options import surface_input, surface_output
+from .options import crop_option, surface_input, surface_output
 from .work_options import jobs_option
 
 
@@ -24,6 +24,7 @@ class WritesCommand(click.Command):
 @click.command(cls=WritesCommand, short_help="Convert between the formats rough reads and writes.")
 @surface_input
 @jobs_option
+@crop_option
 @surface_output
 def convert(surface, input, output):
     """Read INPUT (default: standard input) in any format rough reads, and write it
@@ -36,5 +37,6 @@ def convert(surface, input, output):
         rough convert dektak.csv -o scan.x3p
         cat scan.x3p | rough convert -f exr -o scan.exr
         rough convert scan.x3p -f tsv | gnuplot -e "plot '-' using 1:2 with lines"
+        rough convert --crop 100m:300m,0:200m big.tif -o part.x3p
     """
     output.write(surface.derive("convert", {"input": input, "format": output.format}))

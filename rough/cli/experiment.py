@@ -7,7 +7,8 @@ import secrets
 import click
 
 from .. import experiment as experiments
-from .. import extras, io, plots, render
+from .. import extras, io, render
+from .. import plot as figures
 from ..errors import InputError
 from ..units import format_length, parse_length
 from .haptics import SPEED, TIME, haptic_options
@@ -115,7 +116,7 @@ def design(
             "1",
             "; ".join(
                 f"set {s['id']}: reference D = {result.surfaces[s['reference']]['dimension']:g}, "
-                f"Rq = {result.surfaces[s['reference']]['rq'] * 1e3:.4g} mm, {len(s['neighbours'])} neighbours"
+                f"Rq = {format_length(result.surfaces[s['reference']]['rq'], 4)}, {len(s['neighbours'])} neighbours"
                 for s in result.sets
             ),
         ),
@@ -237,7 +238,7 @@ def analyze(study, set_id, plot, as_json, as_tsv):
         _warn_separation(result)
     if plot:
         sets = [set_id] if set_id else [s["id"] for s in loaded.sets]
-        plots.save(plots.percentage_figure(loaded, sets, title=str(study)), plot)
+        figures.save(figures.percentage_figure(loaded, sets, title=str(study)), plot)
     emit(Report(_table(loaded, result, set_id), result.as_dict()), as_json, as_tsv, study, warnings)
 
 
@@ -267,7 +268,7 @@ def _table(study, result, set_id):
     chosen = [s for s in study.sets if set_id in (None, s["id"])]
     scope = "; ".join(
         f"set {s['id']} (reference D = {study.surfaces[s['reference']]['dimension']:g}, "
-        f"Rq = {study.surfaces[s['reference']]['rq'] * 1e3:.4g} mm)"
+        f"Rq = {format_length(study.surfaces[s['reference']]['rq'], 4)})"
         for s in chosen
     )
     ratio = result.likelihood_ratio

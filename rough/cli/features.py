@@ -6,17 +6,20 @@ import logging
 
 import click
 
-from .. import errors, io, metrology, plots, units
+from .. import errors, io, metrology, units
+from .. import plot as figures
 from .options import (
     LENGTH,
     POSITION,
     RATIO,
     RATIOS,
+    TABLE,
     FloatRange,
     RegistryChoice,
     crop_option,
     plot_option,
     report_format,
+    side_file,
     tiled_input,
 )
 from .report import Report, on_stdout, shown
@@ -93,6 +96,7 @@ from .work_options import jobs_option
     "--list",
     "feature_list",
     metavar="FILE",
+    callback=side_file(TABLE),
     help="Write one TSV row per detected feature (SI units); - is standard output, instead of the report.",
 )
 @click.option(
@@ -142,6 +146,7 @@ from .work_options import jobs_option
 @click.option(
     "--segments",
     metavar="FILE",
+    callback=side_file(TABLE),
     help="Maps: write one TSV row per hill and dale (SI units); - is standard output, instead of the report.",
 )
 @click.option(
@@ -181,7 +186,7 @@ def features(
     first to remove form, or give --cutoff for the roughness). Profiles: Ra, Rq,
     Rsk, Rku, Rdq, Rt over the evaluation length; Rp, Rv, Rz per sampling length
     (λc with --cutoff, ISO 4288), averaged; RSm; peak density (peaks crossing ±5 % of Rz about the mean line, per
-    mm); Z2 and the Tse–Cruden JRC at --jrc-spacing; the material-ratio parameters
+    length: /m or /mm as fits); Z2 and the Tse–Cruden JRC at --jrc-spacing; the material-ratio parameters
     Rmr(c), Rmc(mr), Rδc, Rk, Rpk, Rvk, Mr1, Mr2, A1, A2 (ISO 13565-2) and Rpq, Rvq,
     Rmq (ISO 13565-3); and the slides' feature detection. Maps: Sa, Sq, Ssk, Sku,
     Sp, Sv, Sz, Sdq, Sdr, Sal, Str, Std (ISO 25178-2; Std is the lay direction); the
@@ -240,6 +245,7 @@ def features(
         jrc_spacing=jrc_spacing,
         sampling_length=cutoff,
         acf=acf,
+        families=["field"],
     )
     functional = metrology.functional_parameters(
         evaluated,
@@ -291,8 +297,8 @@ def features(
             stream.write(_feature_table(found).encode())
     if plot:
         curve = metrology.MaterialRatioCurve(evaluated)
-        figure = plots.features_figure(evaluated, found, (centres, density), curve, title=shown(input))
-        plots.save(figure, plot)
+        figure = figures.features_figure(evaluated, found, (centres, density), curve, title=shown(input))
+        figures.save(figure, plot)
     return Report(rows, document) if report else None
 
 

@@ -2,18 +2,21 @@
 
 import click
 
-from .. import fractal, io, plots, units
+from .. import fractal, io, units
+from .. import plot as figures
 from ..errors import InputError
 from .options import (
     BAND,
     DIRECTION,
     LENGTH,
+    TABLE,
     RegistryChoice,
     crop_option,
     gaps_option,
     model_options,
     plot_option,
     report_format,
+    side_file,
     tiled_input,
 )
 from .report import Report, on_stdout, shown
@@ -68,6 +71,7 @@ from .work_options import jobs_option
 @click.option(
     "--psd",
     "psd_file",
+    callback=side_file(TABLE),
     metavar="FILE",
     help="Write the log-binned spectrum as TSV (frequency 1/m, density, count); - is standard output, "
     "instead of the report.",
@@ -150,7 +154,7 @@ def fit_fractal(
         _write_psd(psd_file, spectrum, what, unit)
     if plot and result.scale_dependent:
         title = f"{_title(input, surface)}: no power-law band"
-        plots.save(plots.scale_dependent_figure(result.scale_dependent, title, result.reliability_cutoff), plot)
+        figures.save(figures.scale_dependent_figure(result.scale_dependent, title, result.reliability_cutoff), plot)
     elif plot:
         _plot_spectrum(plot, spectrum, result, surface.spacing, _title(input, surface))
     return Report(_rows(result, surface.is_profile, document), document) if report else None
@@ -241,8 +245,8 @@ def _write_psd(path, spectrum, what, unit="m3", extra=()):
 
 
 def _plot_spectrum(plot, spectrum, fit, spacing, title):
-    figure = plots.spectrum_figure(spectrum["frequency"], spectrum["density"], fit, spacing, title)
-    plots.save(figure, plot)
+    figure = figures.spectrum_figure(spectrum["frequency"], spectrum["density"], fit, spacing, title)
+    figures.save(figure, plot)
 
 
 def _title(input, surface):
@@ -384,17 +388,14 @@ def _dimension_text(result, key):
 
 def _band_text(band, what):
     low, high = band
-    return (
-        f"{low * 1e-3:.4g} to {high * 1e-3:.4g} /mm (wavelengths {units.format_length(1 / high)} to "
-        f"{units.format_length(1 / low)}), {what}"
-    )
+    return f"{units.format_range(low, high, '1/m')} (wavelengths {units.format_range(1 / high, 1 / low, 'm')}), {what}"
 
 
 def _noise_text(result):
     if result.noise_rms is None:
         return "no white noise floor found"
     crossing = (
-        f", above the power law from {result.noise_crossover * 1e-3:.4g} /mm"
+        f", above the power law from {units.format_quantity(result.noise_crossover, '1/m', 4)}"
         if result.noise_crossover
         else ", below the power law throughout the band"
     )

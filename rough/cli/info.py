@@ -3,7 +3,7 @@
 import click
 
 from .. import io, metrology, units
-from .options import report_format, tiled_input
+from .options import crop_option, report_format, tiled_input
 from .report import Report
 from .work_options import jobs_option
 
@@ -11,6 +11,7 @@ from .work_options import jobs_option
 @click.command(short_help="Shape, spacing, size, valid points, z range, Rq/Sq and history.")
 @tiled_input
 @jobs_option
+@crop_option
 @report_format
 def info(surface, input, work):
     """Describe the surface in INPUT (default: standard input).
@@ -23,12 +24,13 @@ def info(surface, input, work):
     \b
     Examples:
         rough info scan.x3p
-        rough synth --length 20mm | rough info
+        rough synth --length 20mm --dimension 1.3 --rq 10um | rough info
         rough info --json scan.x3p | jq .spacing
         rough info --tsv a.x3p b.x3p c.x3p > inventory.tsv
     """
     facts = metrology.summary(surface, **work)
     document = {"format": surface.source_format, **facts}
+    document["units"] = {**facts["units"], "assumed": list(surface.units.assumed)}
     x_by_y = " × ".join
     rms_key = "Rq" if surface.is_profile else "Sq"
     digits = _digits(facts["z_min"], facts["z_max"])
@@ -43,7 +45,15 @@ def info(surface, input, work):
         ),
         ("spacing", facts["spacing"], "m", x_by_y(units.format_length(d) for d in facts["spacing"])),
         ("size", facts["size"], "m", x_by_y(units.format_length(s) for s in facts["size"])),
-        ("origin", facts["origin"], "m", ", ".join(units.format_length(o) for o in facts["origin"])),
+        (
+            "origin",
+            facts["origin"],
+            "m",
+            ", ".join(
+                units.format_length(o, units.digits_for(o, d), scale=d)
+                for o, d in zip(facts["origin"], facts["spacing"])
+            ),
+        ),
         (
             "valid_points",
             facts["valid_points"],
@@ -53,7 +63,7 @@ def info(surface, input, work):
         ("z_min", facts["z_min"], "m", _length(facts["z_min"], digits)),
         ("z_max", facts["z_max"], "m", _length(facts["z_max"], digits)),
         (rms_key, facts[rms_key], "m", f"{_length(facts[rms_key])} (valid points about their mean, not levelled)"),
-        ("units", facts["units"], "", f"in the file: xy {surface.units.xy}, z {surface.units.z}"),
+        ("units", document["units"], "", surface.units.description()),
     ]
     if isinstance(surface, io.TiledSurface):
         rows.append(("tiled", True, "", "read a strip at a time: larger than the memory budget (--memory)"))

@@ -42,6 +42,7 @@ COMMANDS = {
     "render": "rough.cli.render:render",
     "experiment": "rough.cli.experiment:experiment",
     "map": "rough.cli.map:map_command",
+    "report": "rough.cli.reports:report",
 }
 
 log = logging.getLogger("rough")
@@ -96,7 +97,7 @@ class LazyGroup(click.Group):
 
     def get_command(self, ctx, name):
         if name in COMMANDS:
-            return _load(COMMANDS[name])
+            return _take_global_options(_load(COMMANDS[name]))
         plugin = plugins.entry_points("rough.commands").get(name)
         if plugin is None:
             return None
@@ -106,7 +107,7 @@ class LazyGroup(click.Group):
             return BrokenCommand(name, plugin, f"{type(error).__name__}: {error}")
         if not isinstance(command, click.Command):
             return BrokenCommand(name, plugin, f"{type(command).__name__} is not a click command")
-        return command
+        return _take_global_options(command)
 
     def resolve_command(self, ctx, args):
         name, command, rest = super().resolve_command(ctx, args)
@@ -137,11 +138,43 @@ class BrokenCommand(click.Command):
         raise click.ClickException(self.reason)
 
 
+#: The options the group takes before a command's name and every command after it:
+#: ``rough info -q scan.x3p`` is ``rough -q info scan.x3p``.
+GLOBAL_OPTIONS = (
+    (("-q", "--quiet"), {"is_flag": True, "help": "Print errors only, no warnings or notes."}),
+    (("-v", "--verbose"), {"count": True, "help": "Print notes on what is done (-vv: more)."}),
+    (("--debug",), {"is_flag": True, "help": "Show a traceback with every error."}),
+)
+_said = {"quiet": False, "verbose": 0, "debug": False}  # what the group and the command were given
+
+
+def _take_global_options(command):
+    """``command`` (and, for a group, its subcommands) taking :data:`GLOBAL_OPTIONS`
+    after its name too, adding to what the group was given: each once, and none whose
+    name the command (a plugin's) uses for something else."""
+    taken = {name for param in command.params for name in param.opts}
+    command.params += [
+        click.Option(names, expose_value=False, callback=_said_after, **settings)
+        for names, settings in GLOBAL_OPTIONS
+        if not taken & set(names)
+    ]
+    for sub in getattr(command, "commands", {}).values():
+        _take_global_options(sub)
+    return command
+
+
+def _said_after(ctx, param, value):
+    if value:
+        _said[param.name] = _said[param.name] + value if param.name == "verbose" else True
+        configure(**_said)
+    return value
+
+
 @click.group(cls=LazyGroup, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(__version__, "--version", prog_name="rough", message="%(prog)s %(version)s")
-@click.option("-q", "--quiet", is_flag=True, help="Print errors only, no warnings or notes.")
-@click.option("-v", "--verbose", count=True, help="Print notes on what is done (-vv: more).")
-@click.option("--debug", is_flag=True, help="Show a traceback with every error.")
+@click.option(*GLOBAL_OPTIONS[0][0], **GLOBAL_OPTIONS[0][1])
+@click.option(*GLOBAL_OPTIONS[1][0], **GLOBAL_OPTIONS[1][1])
+@click.option(*GLOBAL_OPTIONS[2][0], **GLOBAL_OPTIONS[2][1])
 def cli(quiet, verbose, debug):
     """Surface metrology for rock, worn and machined surfaces.
 
@@ -154,9 +187,16 @@ def cli(quiet, verbose, debug):
         rough info --json scan.x3p | jq .valid_points
 
     Lengths, frequencies and forces name their unit (0.1545mm, 30.9um, 0.2/mm,
-    1N); a number in a file that names no unit is in metres. Invalid points are NaN
-    throughout.
+    1N); a number in a file that names no unit is in metres. Options -q, -v and
+    --debug may also follow the command's name. Invalid points are NaN throughout.
     """
+    _said.update(quiet=quiet, verbose=verbose, debug=debug)
+    configure(quiet, verbose, debug)
+
+
+def configure(quiet=False, verbose=0, debug=False):
+    """Set what reaches standard error: errors only (``quiet``), notes (``verbose``
+    1 or 2), tracebacks (``debug``); progress bars unless ``quiet``."""
     level = logging.ERROR if quiet else (logging.WARNING, logging.INFO, logging.DEBUG)[min(verbose, 2)]
     handler = logging.StreamHandler(sys.stderr) if sys.stderr else logging.NullHandler()
     handler.setFormatter(_Formatter())
@@ -165,6 +205,7 @@ def cli(quiet, verbose, debug):
     log.setLevel(min(level, logging.WARNING))  # warnings reach --json's "warnings" even with -q
     log.propagate = False
     progress.configure(not quiet)
+    _debug[0] = _debug[0] or debug
 
 
 def _warn_in_one_line(message, category, filename, lineno, file=None, line=None):
@@ -264,6 +305,12 @@ def failure(error, debug=None):
         where = f"{error.filename}: " if error.filename else ""
         return f"{where}{error.strerror or error}", 2 if error.filename and error.errno in _BAD_NAME else 1
     return f"internal error: {type(error).__name__}: {error} (run with --debug for details)", 1
+
+
+def note(message):
+    """Print ``rough COMMAND: message`` on standard error, unless ``-q``."""
+    if not _said["quiet"]:
+        say(message)
 
 
 def say(message):

@@ -6,8 +6,9 @@ import click
 
 from .. import metrology
 from ..units import format_length, format_quantity
-from .options import LENGTH, crop_option, report_format, split_input
+from .options import LENGTH, crop_option, report_format, side_file, split_input
 from .report import Report
+from .targets import SURFACE
 from .work_options import jobs_option
 
 
@@ -80,6 +81,7 @@ def _one_output(command):
     "--output",
     "target",
     type=click.Path(dir_okay=False),
+    callback=side_file(SURFACE),
     metavar="FILE",
     help="Write the map: GeoTIFF (.tif, one float32 band per parameter) or, for one parameter, any "
     "format rough writes (.x3p, .npy …). Without it, print a summary.",
@@ -127,7 +129,12 @@ def _report(result):
         ("step", document["step"], "1", f"{sx} × {sy} points"),
         ("grid.shape", grid["shape"], "1", "{} × {} windows".format(*grid["shape"])),
         ("grid.spacing", grid["spacing"], "m", " × ".join(format_length(value) for value in grid["spacing"])),
-        ("grid.origin", grid["origin"], "m", ", ".join(format_length(value) for value in grid["origin"])),
+        (
+            "grid.origin",
+            grid["origin"],
+            "m",
+            ", ".join(format_length(value, scale=step) for value, step in zip(grid["origin"], grid["spacing"])),
+        ),
     ]
     for name, summary in document["parameters"].items():
         unit = summary["unit"]

@@ -34,6 +34,7 @@ from .. import errors, extras, fractal, io, metrology, units
 from ..io import registry
 from . import work_options
 from .batch import check_inputs, read_named, run_each, stem_name
+from .targets import FIGURE, TABLE, TRACE, check_target, side_file  # noqa: F401 -- the commands' options
 
 log = logging.getLogger("rough")
 #: The last release that read a bare number in the option's old unit (with a warning);
@@ -71,6 +72,10 @@ def _refuse_outside(type_, number, bounds, value, param, ctx, what, show, zero=F
 
 def _length(metres):
     return units.format_length(metres, 6)
+
+
+def _frequency(per_metre):
+    return units.format_quantity(per_metre, "1/m", 6)
 
 
 def bare_number(value, flag, unit):
@@ -138,12 +143,13 @@ class FloatRange(click.FloatRange):
 
 
 def plot_option(help):
-    """``--plot FILE``; checks that matplotlib (the ``plot`` extra) is installed before
-    any work starts."""
+    """``--plot FILE``; checks that matplotlib (the ``plot`` extra) is installed and
+    that the figure can be written there (:func:`check_target`) before any work starts."""
 
     def needs_matplotlib(ctx, param, value):
         if value is not None:
             extras.require("matplotlib")
+            check_target(value, param, FIGURE)
         return value
 
     return click.option("--plot", metavar="FILE", callback=needs_matplotlib, help=help)
@@ -167,8 +173,9 @@ class LengthType(click.ParamType):
 
     def checked(self, length, value, param, ctx):
         """``length`` if it is in this type's range; a failure otherwise."""
-        if not abs(length) <= LENGTHS[1]:
-            self.fail(f"{value!r}: a position must lie within {_length(LENGTHS[1])} of the origin", param, ctx)
+        if not (abs(length) <= LENGTHS[1] and (length == 0 or abs(length) >= LENGTHS[0])):
+            near, far = _length(LENGTHS[0]), _length(LENGTHS[1])
+            self.fail(f"{value!r}: a position must be 0 or lie between {near} and {far} from the origin", param, ctx)
         return length
 
 
@@ -318,7 +325,7 @@ class FrequencyRangeType(click.ParamType):
         bounds = (1 / LENGTHS[1], 1 / LENGTHS[0])  # the wavelengths an option may take
         for end in (low, high):
             if end is not None:
-                _refuse_outside(self, end, bounds, value, param, ctx, "a frequency", lambda f: f"{f * 1e-3:.6g}/mm")
+                _refuse_outside(self, end, bounds, value, param, ctx, "a frequency", _frequency)
         if low is not None and high is not None and low >= high:
             self.fail(f"{value!r}: FMIN must be below FMAX, e.g. 0.05/mm:5/mm", param, ctx)
         return low, high
@@ -376,7 +383,7 @@ def crop_option(command):
     return click.option(
         "--crop",
         type=CROP,
-        help="Evaluate only X0:X1 (and Y0:Y1 for maps), e.g. 468um:733um; positions include the origin. "
+        help="Work on X0:X1 only (and Y0:Y1 for maps), e.g. 468um:733um; positions include the origin. "
         "A GeoTIFF is read only in this window.",
     )(command)
 
@@ -580,7 +587,7 @@ def surface_output(command):
 
     @functools.wraps(command)
     def wrapper(*args, output, format=None, **kwargs):
-        output = output if isinstance(output, Output) else Output(output, format)
+        output = output if isinstance(output, Output) else Output(check_target(output, "--output"), format)
         output.check()
         return command(*args, output=output, **kwargs)
 
@@ -640,9 +647,14 @@ class Output:
         return Output(os.path.join(self.path, stem_name("{stem}", name) + extension), format_name)
 
     def check(self):
-        """Refuse, before any work, an output file whose format cannot be told; the
-        format (None for a directory, whose files' format is chosen per input)."""
-        return None if self.is_directory else self.format
+        """Refuse, before any work, an output file that cannot be written
+        (:func:`check_target`) or whose format cannot be told; the format (None for a
+        directory, whose files' format is chosen per input)."""
+        if self.is_directory:
+            return None
+        check_target(self.path, "--output")
+        self._refuse_binary_on_terminal()
+        return self.format
 
     @property
     def format(self):
@@ -654,7 +666,7 @@ class Output:
             error.filename = self.path  # names the output: no input name in front
             raise
 
-    def write(self, surface):
+    def _refuse_binary_on_terminal(self):
         on_terminal = (
             io.standard_output() and sys.stdout.isatty() if self.path == "-" else io.names_a_terminal(self.path)
         )
@@ -663,6 +675,9 @@ class Output:
                 f"refusing to write binary {self.format.upper()} to a terminal: use -o FILE, a pipe, or -f tsv",
                 filename=self.path,
             )
+
+    def write(self, surface):
+        self._refuse_binary_on_terminal()
         if self.path != "-":
             io.write(surface, self.path, format=self.format)
             return

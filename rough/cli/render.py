@@ -5,10 +5,11 @@ import math
 
 import click
 
-from .. import fractal, metrology, plots
+from .. import fractal, metrology
+from .. import plot as figures
 from .. import render as haptic
 from .haptics import DAMPING, FORCE, MASS, SPEED, STIFFNESS, TIME, haptic_options
-from .options import CROP, POSITION, TIP, FloatRange, input_options, plot_option, report_format
+from .options import POSITION, TIP, TRACE, FloatRange, crop_option, input_options, plot_option, report_format, side_file
 from .report import Report, on_stdout, shown
 
 
@@ -60,12 +61,7 @@ from .report import Report, on_stdout, shown
     help="sim: the time the hand takes to reverse, when --duration is longer than one pass (back-and-forth strokes).",
 )
 @click.option("--row", type=POSITION, help="Maps: render only the row at this y position, as a profile.")
-@click.option(
-    "--crop",
-    "window",
-    type=CROP,
-    help="The window X0:X1 to render (X0:X1,Y0:Y1 on a map; lengths; positions include the origin).",
-)
+@crop_option
 @click.option("--fill", is_flag=True, help="Fill invalid points first (linear interpolation).")
 @click.option(
     "--tip",
@@ -76,6 +72,7 @@ from .report import Report, on_stdout, shown
 @click.option(
     "--trace",
     metavar="FILE",
+    callback=side_file(TRACE),
     help="Write one row per tick (t x y_i h F_x F_y contact; .tsv or .npy); {speed} in the name for several speeds.",
 )
 @plot_option("Draw the force profiles.")
@@ -94,7 +91,6 @@ def render(
     direction,
     turn,
     row,
-    window,
     fill,
     tip,
     trace,
@@ -114,8 +110,8 @@ def render(
 
     \b
     Examples:
-        rough synth --length 80mm --dimension 1.275 --rq 0.2781mm | rough resample --step 0.1545mm \\
-            | rough render --speed 20mm/s --speed 60mm/s --speed 120mm/s --trace forces-{speed}.tsv --plot forces.png
+        rough synth --length 80mm --dimension 1.275 --rq 0.2781mm | rough resample --step 0.1545mm -o rock.x3p
+        rough render --speed 20mm/s --speed 60mm/s --speed 120mm/s --trace forces-{speed}.tsv --plot forces.png rock.x3p
         rough render --model dynamic --friction karnopp:static=0.8N,coulomb=0.5N rock.x3p
         rough render --device hid --stick-span 80mm,10mm rough.x3p smooth.x3p
         rough render --device evdev:/dev/input/event5 --stick-span 20mm,20mm bedding-plane.x3p
@@ -127,7 +123,7 @@ def render(
         raise click.BadParameter("with several speeds, the traces need file names with {speed}", param_hint="--trace")
     if trace and len(speeds) > 1 and "{speed}" not in trace:
         raise click.BadParameter("with several speeds, put {speed} in the trace file name", param_hint="--trace")
-    tracks = [_track(surface, window, fill, tip, row) for surface in surfaces]
+    tracks = [_track(surface, fill, tip, row) for surface in surfaces]
     if len({type(track) for track in tracks}) > 1:
         raise click.BadParameter("the two surfaces must both be profiles or both maps (or give --row)")
     settings = haptics.settings(duration, realtime)
@@ -159,10 +155,9 @@ def render(
     return Report(*haptic.summary_rows(runs, haptics.friction)) if report else None
 
 
-def _track(surface, window, fill, tip, row):
-    """The Track (a profile, or a map's row) or MapTrack that ``surface`` is rendered as."""
-    if window is not None:
-        surface = surface.crop(window[0], window[1] if not surface.is_profile else None)
+def _track(surface, fill, tip, row):
+    """The Track (a profile, or a map's row) or MapTrack that ``surface`` (cropped as it
+    was read, ``--crop``) is rendered as."""
     if fill:
         surface = fractal.fill_invalid(surface)
     if tip is not None:
@@ -177,4 +172,4 @@ def _outputs(runs, trace, plot, title):
         for label, result in runs:
             haptic.write_trace(result, trace.replace("{speed}", label))
     if plot:
-        plots.save(plots.force_figure(runs, title=title), plot)
+        figures.save(figures.force_figure(runs, title=title), plot)

@@ -12,9 +12,10 @@ a dict of units by name.
 - ``--json``: the document with ``file`` (the input as given, ``-`` for standard
   input) first and ``warnings`` (what was flagged or undefined) last; NaN as null;
   several inputs: JSON Lines, one object per input.
-- ``--tsv``: rows ``file, key, value, unit`` with no header, plain numbers; a list
-  value becomes the rows ``key.0``, ``key.1``…, a dict value ``key.name``…, so that
-  the outputs of several runs concatenate into one table.
+- ``--tsv``: rows ``file, key, value, unit`` with no header; ``value`` only ever a
+  plain number or empty, a text value (or true/false) in the last column with the
+  value empty; a list value becomes the rows ``key.0``, ``key.1``…, a dict value
+  ``key.name``…, so that the outputs of several runs concatenate into one table.
 """
 
 import contextlib
@@ -102,7 +103,8 @@ class Printer:
         elif self.as_tsv:
             for row in [*filter(lambda row: row[0] is not None, report.rows), ("warnings", warnings, "")]:
                 for key, value, unit in flatten(*row[:3]):
-                    echo("\t".join(printable(part) for part in ("" if file is None else file, key, plain(value), unit)))
+                    parts = ("" if file is None else file, key, *cells(value, unit))
+                    echo("\t".join(printable(part) for part in parts))
         else:
             self._table(report.rows, file)
         self.printed += 1
@@ -123,11 +125,26 @@ def emit(report, as_json=False, as_tsv=False, file=None, warnings=()):
     Printer(as_json, as_tsv).print(report, file, warnings)
 
 
+def cells(value, unit):
+    """The TSV's value and unit cells: a number and its unit (``nan`` for an undefined
+    one: null or NaN), empty and the text for anything else (text, true, false), so
+    that the value column reads as numbers and is empty only in a text row.
+
+    >>> cells(7.2e-08, "m"), cells(float("nan"), "m"), cells(None, "1/m"), cells("m", ""), cells(True, "")
+    (('7.2e-08', 'm'), ('nan', 'm'), ('nan', '1/m'), ('', 'm'), ('', 'true'))
+    """
+    if type(value).__module__ == "numpy":
+        value = value.tolist()
+    if value is None or (isinstance(value, (int, float)) and not isinstance(value, bool)):
+        return plain(value), str(unit)
+    return "", plain(value)
+
+
 def plain(value):
     """A TSV cell: a number as Python writes it back exactly, a boolean as true or
-    false, nothing for None or NaN."""
+    false, ``nan`` for None or NaN (an undefined number)."""
     if value is None or (isinstance(value, float) and math.isnan(value)):
-        return ""
+        return "nan"
     if isinstance(value, bool):
         return str(value).lower()
     if type(value).__module__ == "numpy":

@@ -3,13 +3,14 @@
 import click
 
 from .. import fractal
-from .options import SPACING, Command, surface_input, surface_output
+from .options import SPACING, Command, crop_option, surface_input, surface_output
 from .work_options import jobs_option
 
 
 @click.command(cls=Command, short_help="Resample to a new spacing without aliasing.")
 @surface_input
 @jobs_option
+@crop_option
 @click.option("--step", type=SPACING, required=True, help="The new spacing, e.g. 0.1545mm (or DX,DY for maps).")
 @click.option("--fill", is_flag=True, help="Fill invalid points first (they are NaN again in the result).")
 @surface_output
@@ -25,6 +26,6 @@ def resample(surface, input, step, fill, output):
     \b
     Examples:
         rough resample --step 0.1545mm rock.x3p -o coarse.x3p
-        rough synth --length 80mm --step 0.0309mm --dimension 1.3 --rq 0.3mm | rough resample --step 0.1545mm
+        rough synth --length 80mm --step 30.9um --dimension 1.3 --rq 0.3mm | rough resample --step 154.5um -o coarse.x3p
     """
     output.write(fractal.resample(surface, step[: surface.heights.ndim], fill=fill))

@@ -4,8 +4,9 @@ import math
 
 import click
 
-from .. import fractal, plots
-from ..units import format_length, format_quantity
+from .. import fractal
+from .. import plot as figures
+from ..units import format_length, format_quantity, format_range
 from .options import (
     BAND,
     LENGTH,
@@ -89,7 +90,9 @@ def rose(
     floor. Reports the principal direction (largest C), Ds and C along it and
     across it, the lay at the long-wavelength end and at the resolution η (on a
     fault surface read the long-wavelength lay as the slip direction), χ² tests of
-    isotropy over the sectors not at a bound, and ISO 25178-2 Str and Std. Unequal
+    isotropy over the sectors not at a bound, and ISO 25178-2 Str and Std (of the map
+    less its least-squares plane, so they can differ from those `features` gives on
+    the data as given). Unequal
     x and y spacing is handled exactly (physical frequencies). --profiles adds, beside
     this 2-D sector rose, H(θ), D(θ) and C(θ) fitted on the map's 1-D profiles along
     each direction (what the fault literature reports; see fit-fractal --profiles).
@@ -107,7 +110,7 @@ def rose(
     model.update(rolloff=rolloff, level=level, tip_radius=tip_radius)
     result = fractal.rose(surface, angle_step, width=width, **model)
     if plot:
-        plots.save(plots.rose_figure(result, shown(input)), plot)
+        figures.save(figures.rose_figure(result, shown(input)), plot)
     if on_stdout(plot=plot):
         return None
     document, rows = result.as_dict(), _rows(result)
@@ -215,7 +218,12 @@ def _rows(result):
             else f"χ² p-values: Ds flat {isotropy['fractal_dimension']:.3g}, "
             f"C flat {isotropy['amplitude_coefficient']:.3g}",
         ),
-        ("Str", result.Str, "1", f"{format_quantity(result.Str, '1')} (texture aspect ratio, ISO 25178-2)"),
+        (
+            "Str",
+            result.Str,
+            "1",
+            f"{format_quantity(result.Str, '1')} (texture aspect ratio, ISO 25178-2, plane removed)",
+        ),
         (
             "Std",
             result.Std,
@@ -227,7 +235,7 @@ def _rows(result):
             list(result.band),
             "1/m",
             (
-                f"{result.band[0] * 1e-3:.4g} to {result.band[1] * 1e-3:.4g} /mm ({result.verdict} over the whole map, "
+                f"{format_range(*result.band, '1/m')} ({result.verdict} over the whole map, "
                 f"p = {result.p_value:.3g}), sectors {result.width:g}° wide every {result.step:g}°, C at "
                 f"η = {format_length(result.resolution)}, sampling {result.sampling}"
             ),

@@ -4,8 +4,9 @@ import os
 
 import click
 
-from .. import extras, metrology, plots
-from .options import Command, crop_option, surface_input
+from .. import extras, metrology
+from .. import plot as figures
+from .options import FIGURE, Command, check_target, crop_option, surface_input
 from .report import shown
 from .work_options import jobs_option
 
@@ -13,11 +14,14 @@ FORMATS = ("png", "svg", "pdf")
 
 
 def _needs_matplotlib(ctx, param, value):
-    """Check, before any work, that matplotlib is installed and that the output's
-    format is known (from ``--format`` or the file's extension)."""
+    """Check, before any work, that matplotlib is installed, that the output can be
+    written (:func:`~rough.cli.options.check_target`) and that its format is known
+    (from ``--format`` or the file's extension)."""
     extras.require("matplotlib")
-    if "plot" in ctx.params and "figure_format" in ctx.params:
-        _format(ctx.params["plot"], ctx.params["figure_format"])
+    given = {**ctx.params, param.name: value}
+    if "plot" in given and "figure_format" in given:
+        check_target(given["plot"], "--plot", FIGURE if given["plot"] == "-" else None)  # the suffix: _format
+        _format(given["plot"], given["figure_format"])
     return value
 
 
@@ -108,7 +112,7 @@ def show(surface, input, plot, figure_format, title, hillshade, order, colormap,
         note = {0: "mean removed", 1: "least-squares plane removed"}.get(
             order, f"least-squares polynomial of degree {order} removed"
         )
-    figure = plots.surface_figure(
+    figure = figures.surface_figure(
         surface, title=title or shown(input), hillshade=hillshade, note=note, colormap=colormap
     )
-    plots.save(figure, plot, format=format, dpi=dpi)
+    figures.save(figure, plot, format=format, dpi=dpi)

@@ -122,7 +122,7 @@ def synth(
         rough synth --length 80mm --dimension 1.275 --rq 0.2781mm --seed 1 -o rock.x3p
         rough synth --size 1024x1024 --step 10um --dimension 2.3 --amplitude 1um | rough fit-fractal
         rough synth --size 512x512 --step 10um --dimension 2.3 --anisotropy 2.2,1um,2.5,1um,30 -o layered.x3p
-        rough synth --length 80mm --dimension 1.275 --rq 0.2781mm --fragments
+        rough synth --length 80mm --dimension 1.275 --rq 0.2781mm --fragments | rough fit-fractal
     """
     if size is None and length is None and points is None:
         raise errors.InputError("give --length or --points for a profile, or --size for a map")

@@ -38,9 +38,11 @@ import logging
 
 import numpy as np
 
+from .. import units
 from ..errors import InputError
 from ..metrology import detrend
 from .cross_checks import CROSS_CHECKS
+from .filling import fill_invalid
 from .result import announce
 from .scales import reliability_cutoff, scale_dependent
 from .whittle import (
@@ -57,6 +59,8 @@ from .whittle import (
 
 log = logging.getLogger("rough")
 METHODS = ("whittle", *CROSS_CHECKS)
+#: Why a spectrum refuses a surface with invalid points, naming the keyword and the option that fill them.
+GAPS_REFUSED = "the spectrum needs gap-free data: this surface has invalid points (fill them: fill=True, or --fill)"
 TIP_SPAN = 8  # a tip's cut-off must leave this many wavelengths of the scan length to fit
 
 
@@ -72,14 +76,15 @@ def fit_fractal(
     rolloff=False,
     level=0.01,
     tip_radius=None,
+    fill=False,
 ):
     """The fractal dimension D (Ds for maps) and amplitude coefficient C of a surface.
 
     Parameters
     ----------
     surface : Surface
-        A gap-free profile or map: invalid (NaN) points must have been filled (see
-        :func:`rough.fractal.fill_invalid`).
+        A profile or map; a spectrum needs gap-free data, so invalid (NaN) points
+        are refused unless ``fill`` fills them.
     band : tuple of (float or None), optional
         ``(fmin, fmax)`` in 1/m. With both ends given, exactly that band is fitted.
         Otherwise (the default) the band is the scaling range: the widest band of at
@@ -121,6 +126,10 @@ def fit_fractal(
         The radius of the stylus tip, metres: the frequencies above 1/λc, where the
         tip cannot follow the surface (:func:`rough.fractal.scales.reliability_cutoff`,
         along x for a map), are left out of the fit, and λc is reported.
+    fill : bool, default False
+        Fill invalid points first (:func:`rough.fractal.fill_invalid`: linear along
+        a profile, biharmonic in a map), as ``rough fit-fractal --fill`` does; the
+        fill is recorded in the surface's history.
 
     Returns
     -------
@@ -131,8 +140,8 @@ def fit_fractal(
     Raises
     ------
     rough.InputError
-        For invalid points, an unknown method or sampling, a sector for a profile, a
-        method other than Whittle for a map, a surface that is flat once its form is
+        For invalid points without ``fill``, an unknown method or sampling, a sector
+        for a profile, a method other than Whittle for a map, a surface that is flat once its form is
         removed, too few frequencies (8) or rings (4) in the band, a tip radius that
         is not positive or given with the variogram or madogram, or a tip whose
         reliability cut-off exceeds an eighth of the scan's length.
@@ -163,21 +172,21 @@ def fit_fractal(
 
     A map (Ds = 2.3 by design) needs its invalid points filled first:
 
-    >>> from rough.fractal.filling import fill_invalid
     >>> scan = rough.read(rough.sample("rock-map.x3p"))
     >>> try:
     ...     fit_fractal(scan)
     ... except rough.InputError as error:
     ...     print(error)
-    the spectrum needs gap-free data: this surface has invalid points (fill them with --fill)
-    >>> fit = fit_fractal(fill_invalid(scan))
+    the spectrum needs gap-free data: this surface has invalid points (fill them: fill=True, or --fill)
+    >>> fit = fit_fractal(scan, fill=True)
     >>> print(f"Ds = {fit.fractal_dimension:.2f} ± {fit.fractal_dimension_stderr:.2f}, D = {fit.profile_dimension:.2f}")
     Ds = 2.34 ± 0.03, D = 1.34
     """
     if method not in METHODS:
         raise InputError(f"method must be one of {', '.join(METHODS)}, not {method!r}")
+    surface = fill_invalid(surface) if fill else surface
     if np.isnan(surface.heights).any():
-        raise InputError("the spectrum needs gap-free data: this surface has invalid points (fill them with --fill)")
+        raise InputError(GAPS_REFUSED)
     if sampling is not None and sampling not in SAMPLINGS:
         raise InputError(f"sampling must be one of {', '.join(SAMPLINGS)}, not {sampling!r}")
     if not 0 < level < 1:
@@ -223,13 +232,15 @@ def tip_cutoff(levelled, surface, tip_radius):
     length = heights.shape[-1] * surface.spacing[0]
     if cutoff is not None and cutoff > length / TIP_SPAN:
         raise InputError(
-            f"a tip of radius {tip_radius:g} m cannot follow this surface below {cutoff:.4g} m, more than "
-            f"1/{TIP_SPAN} of the scan's length along x ({length:.4g} m): too few scales are left to fit"
+            f"a tip of radius {units.format_length(tip_radius, 4)} cannot follow this surface below "
+            f"{units.format_length(cutoff, 4)}, more than 1/{TIP_SPAN} of the scan's length along x "
+            f"({units.format_length(length, 4)}): too few scales are left to fit"
         )
     if cutoff is not None:
         log.warning(
-            f"a tip of radius {tip_radius:g} m cannot follow the surface below {cutoff:.4g} m (the curvature "
-            f"criterion): frequencies above {1e-3 / cutoff:.4g}/mm are left out of the fit"
+            f"a tip of radius {units.format_length(tip_radius, 4)} cannot follow the surface below "
+            f"{units.format_length(cutoff, 4)} (the curvature criterion): frequencies above "
+            f"{units.format_quantity(1 / cutoff, '1/m', 4)} are left out of the fit"
         )
     return cutoff
 

@@ -39,6 +39,7 @@ import numpy as np
 from scipy.optimize import minimize, minimize_scalar
 from scipy.special import chdtrc, gammainc, gammaincc, ndtri, zeta  # scipy.stats' own, without its import time
 
+from .. import units
 from ..compiled import one_blas_thread
 
 GOF_PER_DECADE = 10
@@ -622,16 +623,21 @@ def nearest_fractal(grid, exponent_range, decades=1.0):
     if best is None:
         return "the spectrum spans less than a decade: use more points or a longer scan"
     slope, first, stop = best
-    low, high = math.exp(log_f[first]) * 1e-3, math.exp(log_f[stop]) * 1e-3
+    low, high = math.exp(log_f[first]), math.exp(log_f[stop])
+    over = units.format_range(low, high, "1/m")
     if not exponent_range[0] < slope < exponent_range[1]:
-        return (
-            f"the local exponent lies outside a fractal's range at every scale (nearest {slope:.2f}, over "
-            f"{low:.4g}/mm to {high:.4g}/mm)"
-        )
-    return (
-        f"the local exponent comes nearest a fractal's ({slope:.2f}) over {low:.4g}/mm to {high:.4g}/mm: "
-        f"try --band {low:.4g}/mm:{high:.4g}/mm"
-    )
+        return f"the local exponent lies outside a fractal's range at every scale (nearest {slope:.2f}, over {over})"
+    return f"the local exponent comes nearest a fractal's ({slope:.2f}) over {over}: try --band {band_text(low, high)}"
+
+
+def band_text(low, high):
+    """A band of spatial frequencies (1/m) as ``--band`` takes it, each end in the prefix
+    that fits it, without spaces (a hint the user pastes back).
+
+    >>> band_text(0.03347, 0.2265), band_text(7140.0, 7.167e4)
+    ('33.47/km:226.5/km', '7.14/mm:71.67/mm')
+    """
+    return ":".join(units.format_quantity(end, "1/m", 4).replace(" ", "") for end in (low, high))
 
 
 def decades(low, high):

@@ -33,7 +33,8 @@ from ..errors import InputError
 from ..metrology import detrend
 from ..metrology.spatial import autocorrelation_lengths, texture_direction
 from ..progress import progress
-from .fit import below_cutoff, tip_cutoff
+from .filling import fill_invalid
+from .fit import GAPS_REFUSED, below_cutoff, tip_cutoff
 from .psd import sector_spectra, windowed_map
 from .scaling import ring_bins
 from .whittle import MAP_RANGE, Options, band_outcome, map_band, refuse_flat, ring_fit, sampling_of
@@ -199,6 +200,7 @@ def rose(
     rolloff=False,
     level=0.01,
     tip_radius=None,
+    fill=False,
 ):
     """D(θ) and C(θ) of a map: the amplitude coefficient rose.
 
@@ -209,8 +211,8 @@ def rose(
     Parameters
     ----------
     surface : Surface
-        A gap-free map: fill invalid (NaN) points first (see
-        :func:`~rough.fractal.fill_invalid`).
+        A map; a spectrum needs gap-free data, so invalid (NaN) points are refused
+        unless ``fill`` fills them.
     step : float, default 10.0
         The spacing of the sector centres, degrees; it must divide 180 and be at
         most 90.
@@ -233,6 +235,9 @@ def rose(
         A tip radius, metres: the band stops at the wavelength below which such a
         tip cannot follow the map's rows (as for :func:`~rough.fractal.fit_fractal`),
         recorded as ``reliability_cutoff``.
+    fill : bool, default False
+        Fill invalid points first (:func:`~rough.fractal.fill_invalid`, biharmonic),
+        as ``rough rose --fill`` does.
 
     Returns
     -------
@@ -243,7 +248,7 @@ def rose(
     Raises
     ------
     rough.InputError
-        For a profile, invalid points, a step or width out of range, a surface that
+        For a profile, invalid points without ``fill``, a step or width out of range, a surface that
         is flat once its form is removed, or a sector holding fewer than four
         frequency rings in the band.
 
@@ -274,8 +279,9 @@ def rose(
     """
     if surface.is_profile:
         raise InputError("a rose needs a map (a direction in the plane); this is a profile")
+    surface = fill_invalid(surface) if fill else surface
     if np.isnan(surface.heights).any():
-        raise InputError("the spectrum needs gap-free data: this map has invalid points (fill them with --fill)")
+        raise InputError(GAPS_REFUSED)
     width = step if width is None else width
     if not (0 < step <= 90 and 180 % step < 1e-9 and 0 < width <= 180):
         raise InputError(f"the step must divide 180° and the width lie in (0°, 180°]: step {step}°, width {width}°")

@@ -229,10 +229,10 @@ def synthesize_fragments(
         pieces.append(piece)
     heights = scaled(np.concatenate(pieces)[:points], rq)
     log.warning(
-        "fragments of %d points (%.4g mm) drop every wavelength longer than a fragment: the profile's Rq "
+        "fragments of %d points (%s) drop every wavelength longer than a fragment: the profile's Rq "
         "falls well short of eq. (2) (docs: Mathematics §2.5); use the default whole-length synthesis",
         fragment,
-        fragment * spacing * 1e3,
+        format_length(fragment * spacing, 4),
     )
     parameters = given_parameters(
         points=points,

@@ -47,6 +47,7 @@ from ..surface import Surface
 from ..units import format_length
 from .choices import SAMPLINGS
 from .filling import fill_invalid, filled
+from .fit import GAPS_REFUSED
 from .psd import binned_rings, sector_spectra, windowed_map
 from .result import FractalFit, announce
 from .whittle import FLAT, LOWEST_RING, Options, default_top, fit_rings, history_sampling, sampling_of
@@ -295,7 +296,7 @@ def _tile_part(item):
     invalid = np.isnan(heights)
     part = {"rings": None, "full": None}
     if invalid.any() and not plan.fill:
-        raise InputError("the spectrum needs gap-free data: this map has invalid points (fill them with --fill)")
+        raise InputError(GAPS_REFUSED)
     if invalid[tile].mean() <= MOST_INVALID:
         if invalid.any():
             heights = filled(Surface(heights, tiled.spacing))

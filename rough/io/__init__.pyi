@@ -12,6 +12,7 @@ from .reading import gunzip as gunzip
 from .reading import read as read
 from .reading import read_bytes as read_bytes
 from .reading import read_options as read_options
+from .receiving import is_terminal as is_terminal
 from .receiving import widen_pipe as widen_pipe
 from .registry import describe as describe
 from .registry import sniff as sniff

@@ -180,13 +180,14 @@ def _described(dataset, options, file_bytes):
     band = choose_channel(names, options.channel, 0)
     grid = _Grid(dataset, options)
     _check_bytes(dataset, file_bytes)
-    metres, z_unit = _height_unit(dataset, band)
+    metres, z_unit, z_stated = _height_unit(dataset, band)
+    assumed = tuple(axis for axis, stated in (("xy", dataset.crs is not None), ("z", z_stated)) if not stated)
     metadata = {**_facts(dataset), **grid.metadata}
     if len(names) > 1:
         metadata.update(channel_metadata(names, band))
     restored, units, history = provenance.restore(
         {part: dataset.tags().get(TAGS[part]) for part in provenance.PARTS},
-        units=Units(grid.unit, z_unit),
+        units=Units(grid.unit, z_unit, assumed),
     )
     return band, grid, metres, (units, {**restored, **metadata}, history)
 
@@ -348,12 +349,13 @@ def _file_bytes(dataset):
 
 
 def _height_unit(dataset, band):
-    """``(metres per unit, unit name)`` of a band's heights (metres when the band names none)."""
+    """``(metres per unit, unit name, stated)`` of a band's heights (metres, not stated, when the band
+    names none or a unit that is not a length)."""
     name = (dataset.units[band] or "").strip()
     if name.lower() in HEIGHT_UNITS:
-        return HEIGHT_UNITS[name.lower()]
+        return (*HEIGHT_UNITS[name.lower()], bool(name))
     log.warning("the GeoTIFF band's unit %r is not a length rough knows; its heights are taken as metres", name)
-    return 1.0, name
+    return 1.0, name, False
 
 
 def _check_bytes(dataset, file_bytes):

@@ -61,10 +61,12 @@ def _surface(h5py, handle, options, file_bytes):
             f"HDF5 dataset {names[index]!r} ({cols}×{rows} points) carries no spacing; give --spacing DX or DX,DY "
             "(and --unit for the heights' unit, default m)"
         )
-    unit = _unit(dataset) or options.unit or "m"
+    stated = _unit(dataset)
+    unit = stated or options.unit or "m"
     heights = np.asarray(dataset[()], dtype=np.float64) * metres_per(unit)
     metadata = channel_metadata(names, index)
-    return Surface(heights, options.spacing, units=Units("m", unit), metadata=metadata)
+    units = Units("m", unit, () if stated else ("z",))  # the spacing is --spacing's, a length with its unit
+    return Surface(heights, options.spacing, units=units, metadata=metadata)
 
 
 def _check_bytes(dataset, name, file_bytes):

@@ -11,12 +11,14 @@ import os
 import numpy as np
 
 from ..errors import FormatError
-from ..surface import Surface
+from ..surface import Surface, Units
 from .registry import Format
 from .tiled import TiledSurface
 from .windowed import FileSource, finite
 
 FORMAT = Format("npy", "NumPy NPY", (".npy",), magic=(b"\x93NUMPY",), writes=True, carries=("tiles",))
+#: Heights read as metres and spacing from ``--spacing``: the file states no unit.
+UNITS = Units("m", "m", assumed=("xy", "z"))
 
 
 def read(data, options):
@@ -27,7 +29,7 @@ def read(data, options):
     count = int(np.prod(shape, dtype=object))
     heights = np.frombuffer(data, dtype, count=count, offset=offset)
     heights = heights.reshape(shape[::-1]).T if fortran else heights.reshape(shape)
-    return Surface(heights.astype(np.float64), options.spacing[: len(shape)])
+    return Surface(heights.astype(np.float64), options.spacing[: len(shape)], units=UNITS)
 
 
 def open_tiles(path, options):
@@ -37,7 +39,7 @@ def open_tiles(path, options):
         shape, _, _, _ = _header(stream, os.fstat(stream.fileno()).st_size, options)
     if len(shape) != 2 or shape[0] * shape[1] < 2:
         return None
-    return TiledSurface(NpySource(path), tuple(shape), tuple(options.spacing[:2]))
+    return TiledSurface(NpySource(path), tuple(shape), tuple(options.spacing[:2]), units=UNITS)
 
 
 def _header(stream, size, options):

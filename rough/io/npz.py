@@ -77,7 +77,8 @@ def read(data, options):
     for axis in flips:
         heights = np.flip(heights, axis=heights.ndim - 1 - axis)
     metadata = channel_metadata(names, index)
-    return Surface(np.asarray(heights, np.float64), spacing, origin, units=Units("m", "m"), metadata=metadata)
+    units = Units("m", "m", assumed=("xy", "z"))  # NPZ states no unit: metres
+    return Surface(np.asarray(heights, np.float64), spacing, origin, units=units, metadata=metadata)
 
 
 def default_channel(names):

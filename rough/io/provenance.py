@@ -12,7 +12,10 @@ PARTS = ("units", "metadata", "history")
 
 def parts(surface):
     """The three parts as JSON-able objects, keyed by part name."""
-    return {"units": vars(surface.units), "metadata": surface.metadata, "history": surface.history}
+    units = {"xy": surface.units.xy, "z": surface.units.z}
+    if surface.units.assumed:  # files written before 0.15 had no such key: written only when it says something
+        units["assumed"] = list(surface.units.assumed)
+    return {"units": units, "metadata": surface.metadata, "history": surface.history}
 
 
 def record(surface):
@@ -30,7 +33,11 @@ def restore(stored, metadata=None, units=None):
             raise FormatError(f"rough's {part} record in the file is damaged")
     metadata = {**(metadata or {}), **{str(k): str(v) for k, v in given.get("metadata", {}).items()}}
     if "units" in given:
-        units = Units(**{k: str(v) for k, v in given["units"].items() if k in ("xy", "z")})
+        stated = given["units"]
+        assumed = stated.get("assumed", [])
+        if not isinstance(assumed, list):
+            raise FormatError("rough's units record in the file is damaged")
+        units = Units(**{k: str(stated[k]) for k in ("xy", "z") if k in stated}, assumed=tuple(map(str, assumed)))
     history = given.get("history", [])
     for number, entry in enumerate(history, start=1):
         if not isinstance(entry, dict) or not isinstance(entry.get("parameters", {}), dict):

@@ -317,7 +317,7 @@ def _checked(surface, format_name, options, windowed=False):
         x, y = options.window
         if y is not None and surface.is_profile:
             raise InputError("a profile has no y range; crop it with X0:X1")
-        surface = surface.crop(x, y)
+        surface = dataclasses.replace(surface.crop(x, y), source_format=surface.source_format)
     return surface
 
 

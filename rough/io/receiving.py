@@ -37,8 +37,11 @@ def read_capped(stream, what, is_text=None):
     MAX_TEXT_BYTES once its first bytes show text (``is_text(head)``, asked with up
     to :data:`rough.io.registry.HEAD` bytes): the cap applies while the bytes arrive,
     so a stream is never read further than it. A zip archive comes back as a read-only
-    memoryview, hashed as it arrived (:func:`receive`)."""
+    memoryview, hashed as it arrived (:func:`receive`); a terminal is read as typed,
+    up to one Ctrl-D (:func:`typed`)."""
     limit = limits.cap("MAX_INPUT_BYTES")
+    if is_terminal(stream):
+        return typed(stream, what, min(limit, limits.cap("MAX_TEXT_BYTES")))
     received = receive(stream, what, limit)
     if received is not None:
         return received
@@ -66,6 +69,29 @@ def read_capped(stream, what, is_text=None):
     if text is None and total > limits.cap("MAX_TEXT_BYTES") and is_text(data):
         raise limits.too_much_text(total)
     return data
+
+
+def typed(stream, what, limit):
+    """What is typed at a terminal, up to the first end of input (Ctrl-D at the start
+    of a line, as ``cat`` takes it): each read returns what the terminal has, a line
+    at a time, so one Ctrl-D ends it (a read of whole chunks would wait for a second).
+    Refused past ``limit`` bytes."""
+    parts, total = [], 0
+    read = getattr(stream, "read1", stream.read)  # one read of the terminal at a time
+    while part := read(limits.CHUNK):
+        parts.append(part)
+        total += len(part)
+        if total > limit:
+            raise limits.too_large(what, limit)
+    return b"".join(parts)
+
+
+def is_terminal(stream):
+    """Whether ``stream`` (standard input or output, an open file, or None) is a terminal."""
+    try:
+        return stream.isatty()
+    except (AttributeError, OSError, ValueError):  # a closed or unusual stream
+        return False
 
 
 def receive(stream, what, limit):

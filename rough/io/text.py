@@ -274,28 +274,40 @@ def _read_columns(lines, options):
     table, names, units_row = table[:, first:], names[first:], units_row and units_row[first:]
     count = table.shape[1]
     default_unit = settings.get("unit") or options.unit or "m"
-    units = [_unit_of(name, default_unit) for name in (units_row or names or [""] * count)]
-    units += [default_unit] * (count - len(units))
+    named = [_unit_of(name, None) for name in (units_row or names or [""] * count)]
+    named += [None] * (count - len(named))
+    units = [unit or default_unit for unit in named]
+    stated = [unit is not None or "unit" in settings for unit in named]
     lower = [n.strip().lower() for n in names]
     if count >= 3 and any("valid" in n or "mask" in n for n in lower):
         flag = next(i for i, n in enumerate(lower) if "valid" in n or "mask" in n)
         keep = [i for i in range(count) if i != flag][:2]
         heights = np.where(table[:, flag] != 0, table[:, keep[1]], np.nan)
         x_tokens = _column_tokens(body, delimiter, first + keep[0])
-        return settings, _profile(
-            table[:, keep[0]], heights, (units[keep[0]], units[keep[1]]), settings, options, x_tokens
-        )
+        surface = _profile(table[:, keep[0]], heights, (units[keep[0]], units[keep[1]]), settings, options, x_tokens)
+        return settings, _stating(surface, stated[keep[0]], stated[keep[1]])
     if count == 1:
-        return settings, _from_spacing(table[:, 0] * metres_per(units[0]), options, settings, Units(units[0], units[0]))
+        surface = _from_spacing(table[:, 0] * metres_per(units[0]), options, settings, Units(units[0], units[0]))
+        return settings, _stating(surface, stated[0], stated[0])
     if count == 2:
         x_tokens = _column_tokens(body, delimiter, first)
-        return settings, _profile(table[:, 0], table[:, 1], units[:2], settings, options, x_tokens)
+        surface = _profile(table[:, 0], table[:, 1], units[:2], settings, options, x_tokens)
+        return settings, _stating(surface, stated[0], stated[1])
     if count == 3:
-        return settings, _grid(table, units, settings)
+        return settings, _stating(_grid(table, units, settings), stated[0], stated[2])
     heights = table * metres_per(default_unit)
-    return settings, _from_spacing(
+    surface = _from_spacing(
         heights if len(heights) > 1 else heights[0], options, settings, Units(default_unit, default_unit)
     )
+    return settings, _stating(surface, "unit" in settings, "unit" in settings)
+
+
+def _stating(surface, xy_stated, z_stated):
+    """``surface`` with the axes whose unit the file does not state in ``units.assumed``."""
+    assumed = tuple(axis for axis, stated in (("xy", xy_stated), ("z", z_stated)) if not stated)
+    if assumed:
+        surface.units = Units(surface.units.xy, surface.units.z, assumed)
+    return surface
 
 
 def _dektak(lines, options):
@@ -370,7 +382,8 @@ def _key_value_matrix(lines, options):
     else:
         z_unit = options.unit or "m"
         z_factor = metres_per(z_unit)
-    units = Units(xy_unit, header.get("data unit", z_unit))
+    assumed = () if factor_key or "data unit" in header else ("z",)
+    units = Units(xy_unit, header.get("data unit", z_unit), ("xy", *assumed) if "pixel size" not in header else assumed)
     if table.shape[0] == 1:
         return Surface(table[0] * z_factor, spacing[:1], units=units)
     return Surface(table * z_factor, spacing, units=units)

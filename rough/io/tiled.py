@@ -194,14 +194,17 @@ def open_surface(source, *, memory=None, **options):
     :class:`TiledSurface` when its format reads windows (``rough formats``: "tiles")
     and the whole map would take more than the ``memory`` budget (bytes, default
     :func:`memory_budget`) at :data:`BYTES_PER_POINT`. ``options`` are those of
-    :func:`rough.io.read`; a crop is applied to the tiled view."""
+    :func:`rough.io.read`; a crop is applied to the tiled view. The map is described
+    from its header first and its data checked (checksums) only once: by the whole
+    read, or before the first tile."""
     budget = memory_budget() if memory is None else memory
     with held_warnings() as said:  # given out only when the map is read in tiles: read() says its own
-        tiled = open_tiles(source, **options) if isinstance(source, (str, os.PathLike)) else None
+        tiled = _described(source, options) if isinstance(source, (str, os.PathLike)) else None
     if tiled is None or tiled.point_count * BYTES_PER_POINT <= budget:
         return read(source, **options)
     for record in said:
         log.handle(record)
+    _checked(tiled)
     log.info(
         "%s: %s points would need ~%s in memory, over the budget of %s: read in tiles of up to %s points",
         source,
@@ -215,7 +218,22 @@ def open_surface(source, *, memory=None, **options):
 
 def open_tiles(path, **options):
     """A :class:`TiledSurface` of the map in ``path`` when its format reads windows,
-    else None (options as :func:`rough.io.read`'s)."""
+    else None (options as :func:`rough.io.read`'s); its data are checked (checksums)
+    as a whole read checks them."""
+    tiled = _described(path, options)
+    return None if tiled is None else _checked(tiled)
+
+
+def _checked(tiled):
+    """``tiled``, once its source's data pass the checks a whole read makes."""
+    path = tiled.source.path
+    with _named(path), _malformed(lambda: registry.describe(tiled.source_format)), np.errstate(all="ignore"):
+        tiled.source.check()
+    return tiled
+
+
+def _described(path, options):
+    """The tiled view of ``path`` from its header (data not yet checked), or None."""
     path = os.fspath(path)
     if path == "-" or not os.path.isfile(path):
         return None

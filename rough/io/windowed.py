@@ -56,6 +56,10 @@ class FileSource:
     def opened(self):
         raise NotImplementedError
 
+    def check(self):
+        """Check the data as a whole read of the file would (e.g. a checksum over
+        them), raising FormatError; a source whose reads check themselves does nothing."""
+
 
 def mapped(path):
     """A read-only memory map of a whole file (FormatError for an empty one)."""

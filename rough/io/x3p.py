@@ -134,9 +134,10 @@ def read(data, options):
 def open_tiles(path, options):
     """A :class:`~rough.io.tiled.TiledSurface` of a binary X3P map read a window at a
     time from disk (a stored data member memory-mapped, a deflated one decompressed as
-    far as each window), with the data's MD5 checked in one pass now, as :func:`read`
-    checks it; None for what is read whole: profiles, point clouds, inline DataList,
-    absolute or rotated axes, and data compressed otherwise than by deflate."""
+    far as each window), described from the header: the data's MD5 is checked by
+    the source's ``check()`` (:func:`rough.io.open_tiles` calls it); None for what is
+    read whole: profiles, point clouds, inline DataList, absolute or rotated axes, and
+    data compressed otherwise than by deflate."""
     data = windowed.mapped(path)
     header = _Header(data, options)
     axes, root = header.axes, header.root
@@ -153,13 +154,14 @@ def open_tiles(path, options):
     link = _text(root, "Record3/DataLink/PointDataLink", required=True)
     count, dtype = header.nx * header.ny * header.layers, np.dtype(axes["CZ"]["dtype"])
     stated = _text(root, "Record3/DataLink/MD5ChecksumPointData")
-    info = open_data(header.archive, header.prefix, link, data, stated, options.verify, count * dtype.itemsize)
+    info = open_data(header.archive, header.prefix, link, data, count * dtype.itemsize)
     if info is None:
         return None
     mask = _mask(header.archive, header.prefix, root, data, count, options.verify)[0]
     layer = _chosen_layer(options.layer, header.layers)
     metadata, units, history = _provenance(header, data, layer)
-    source = DataSource(path, info.filename, mask, (dtype.str, header.nx, layer * header.ny), axes["CZ"])
+    layout = (dtype.str, header.nx, layer * header.ny)
+    source = DataSource(path, info.filename, mask, layout, axes["CZ"], stated, options.verify)
     origin = (0.0 + axes["CX"]["offset"], 0.0 + axes["CY"]["offset"])  # as _surface places them
     return TiledSurface(source, (header.ny, header.nx), spacing, origin, units, metadata, history)
 

@@ -4,9 +4,11 @@ metres, and read a window at a time from disk for :func:`rough.io.x3p.open_tiles
 Checks: :func:`checked_member` hashes a member once, MD5 and CRC-32 together, and
 holds it to main.xml's MD5 (a mismatch refuses the file unless ``verify`` is False,
 when it warns) and to its zip CRC-32 only where no MD5 is checked. A map read in
-windows is checked the same way when it is opened: a stored member in one pass over
-its bytes on disk, a deflated one in one streaming pass of its decompressed bytes
-(:func:`open_data`), so that no window is ever read from data that fail.
+windows is described from its header (:func:`open_data`), then checked the same way
+before its first window (:meth:`DataSource.check`, which :func:`rough.io.open_tiles`
+calls): a stored member in one pass over its bytes on disk, a deflated one in one
+streaming pass of its decompressed bytes, so that no window is ever read from data
+that fail, and a map that turns out to fit in memory is checked once, by its read.
 
 Windows (:class:`DataSource`): a stored member is a memory map of the file at the
 member's data; a deflated one is decompressed front to back as far as the rows asked
@@ -137,10 +139,11 @@ def data_start(info, data):
     return start
 
 
-def open_data(archive, prefix, link, data, stated, verify, size):
+def open_data(archive, prefix, link, data, size):
     """The zip entry of a data member that :class:`DataSource` can read in windows
-    (stored or deflated), its data checked as :func:`checked_member` checks them;
-    None for another compression (the caller reads the file whole)."""
+    (stored or deflated, of the size the header implies; its checksum is
+    :meth:`DataSource.check`'s); None for another compression (the caller reads the
+    file whole)."""
     try:
         info = archive.getinfo(f"{prefix}{link}")
     except KeyError:
@@ -148,14 +151,17 @@ def open_data(archive, prefix, link, data, stated, verify, size):
     if info.compress_type not in (zipfile.ZIP_STORED, zipfile.ZIP_DEFLATED):
         return None
     _sized(info, expected=size)
+    data_start(info, data)
+    return info
+
+
+def _member_digests(info, data):
+    """``(MD5 hex, CRC-32)`` of a stored or deflated member, in one pass, none kept."""
     start = data_start(info, data)
     packed = memoryview(data)[start : start + info.compress_size]
     if info.compress_type == zipfile.ZIP_STORED:
-        digests = _digests(packed[at : at + HASHED_STEP] for at in range(0, size, HASHED_STEP))
-    else:
-        digests = _digests(_inflated_parts(info, packed))
-    _judge(info, link, digests, stated, verify)
-    return info
+        return _digests(packed[at : at + HASHED_STEP] for at in range(0, info.file_size, HASHED_STEP))
+    return _digests(_inflated_parts(info, packed))
 
 
 def _inflated_parts(info, packed):
@@ -238,11 +244,22 @@ class DataSource(FileSource):
     as :func:`scaled` does, invalid points (the mask, ±inf) NaN.
 
     ``data`` and ``mask`` are zip entry names; ``layout`` is ``(dtype, nx, first
-    row of the layer in the member)``; ``axis`` is the CZ axis's description."""
+    row of the layer in the member)``; ``axis`` is the CZ axis's description;
+    ``stated`` the data's MD5 as the header gives it (or None) and ``verify``
+    whether a wrong one is an error (:func:`check`)."""
 
-    def __init__(self, path, data, mask, layout, axis):
+    def __init__(self, path, data, mask, layout, axis, stated=None, verify=True):
         super().__init__(path)
         self.data, self.mask, self.layout, self.axis = data, mask, layout, axis
+        self.stated, self.verify = stated, verify
+
+    def check(self):
+        """The data member's MD5 (its zip CRC-32 when the header states none) over one
+        pass, as a whole read checks it: FormatError when it fails."""
+        file = mapped(self.path)
+        with zipfile.ZipFile(ziparchive.ViewFile(file)) as archive:
+            info = archive.getinfo(self.data)
+            _judge(info, info.filename, _member_digests(info, file), self.stated, self.verify)
 
     def opened(self):
         return _Opened(self.path, self.data, self.mask, self.layout)

@@ -7,6 +7,7 @@ from .choices import ENDS as ENDS
 from .choices import MODES as MODES
 from .choices import POLARITIES as POLARITIES
 from .choices import SLOPES as SLOPES
+from .evaluation import FAMILIES as FAMILIES
 from .evaluation import UNDEFINED as UNDEFINED
 from .evaluation import announce_undefined as announce_undefined
 from .evaluation import parameters as parameters

@@ -1,13 +1,12 @@
 """What ``rough info`` reports: the facts of a surface, in SI units."""
 
-import fractions
 import math
 
 import numpy as np
 
 from .. import tasks
 from ..io.tiled import TiledSurface
-from .heights import SUBNORMAL, exact_sum
+from .heights import exact_mean, strip_extent
 
 
 def summary(surface, *, budget=None, jobs=1, scheduler=None):
@@ -57,23 +56,19 @@ def _tiled_statistics(tiled, budget, run):
     """(valid points, {min, max, mean, rms}) of a map read a strip at a time."""
     rows = tiled.strip_rows(budget)
     strips = [(tiled, first, rows) for first in range(0, tiled.shape[0], rows)]
-    parts = list(tasks.map_ordered(_strip_extent, strips, **run))
-    count = sum(part[0] for part in parts)
+    parts = [part for part in tasks.map_ordered(_strip_extent, strips, **run) if part["count"]]
+    count = sum(part["count"] for part in parts)
     if not count:
         return 0, {"min": None, "max": None, "mean": None, "rms": None}
-    mean = float(fractions.Fraction(sum(part[1] for part in parts), count << SUBNORMAL))
+    mean = exact_mean(sum(part["sum"] for part in parts), count)
     squares = math.fsum(tasks.map_ordered(_strip_squares, [(*strip, mean) for strip in strips], **run))
-    low = min(part[2] for part in parts if part[0])
-    high = max(part[3] for part in parts if part[0])
+    low = min(part["low"] for part in parts)
+    high = max(part["high"] for part in parts)
     return count, {"min": low, "max": high, "mean": mean, "rms": math.sqrt(squares / count)}
 
 
 def _strip_extent(item):
-    tiled, first, rows = item
-    values = _valid(tiled, first, rows)
-    if not values.size:
-        return 0, 0, math.nan, math.nan
-    return values.size, exact_sum(values), float(values.min()), float(values.max())
+    return strip_extent(_valid(*item))
 
 
 def _strip_squares(item):

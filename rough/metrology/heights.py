@@ -9,6 +9,7 @@ pairs of neighbouring valid points, by default forward differences
 surfalize's Rdq), or ISO 4287's seven-point derivative (``slope="7point"``).
 """
 
+import fractions
 import math
 
 import numpy as np
@@ -177,3 +178,23 @@ def exact_sum(values):
             if upper or lower:
                 total += ((int(upper) << 26) + int(lower)) << (k + lowest - 53 + SUBNORMAL)
     return total
+
+
+def strip_extent(values):
+    """``{count, sum, low, high}`` of one strip's valid heights (no NaN): the exact
+    sum of :func:`exact_sum`, the extremes NaN for an empty strip. Strips combine by
+    adding counts and sums (:func:`exact_mean`) and taking the extremes of the rest."""
+    if not values.size:
+        return {"count": 0, "sum": 0, "low": math.nan, "high": math.nan}
+    return {"count": values.size, "sum": exact_sum(values), "low": float(values.min()), "high": float(values.max())}
+
+
+def exact_mean(total, count):
+    """The correctly rounded mean of ``count`` values whose :func:`exact_sum` is
+    ``total`` (NaN when there are none).
+
+    >>> values = np.array([0.1, 0.2, 0.3])
+    >>> exact_mean(exact_sum(values), 3) == 0.2
+    True
+    """
+    return float(fractions.Fraction(total, count << SUBNORMAL)) if count else math.nan

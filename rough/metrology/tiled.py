@@ -18,7 +18,6 @@ needs the global mean anyway, and sums about it are the in-memory path's own.
 """
 
 import dataclasses
-import fractions
 import logging
 import math
 
@@ -29,7 +28,7 @@ from ..errors import InputError
 from . import tiled_material, tiled_spectrum
 from .areal import AREAL
 from .evaluation import announce_undefined
-from .heights import MAGNITUDE, ROUNDING, SUBNORMAL, check_slope, exact_sum, slopes
+from .heights import MAGNITUDE, ROUNDING, check_slope, exact_mean, slopes, strip_extent
 from .material_ratio import AREAL_FUNCTIONAL
 from .segmentation import FEATURE
 
@@ -240,7 +239,7 @@ def _first_pass(tiled, strips, slope, run):
         )
     pairs = sum(part["pairs"] for part in parts)
     square, developed = (math.fsum(part[key] for part in parts) for key in ("square", "developed"))
-    mean = float(fractions.Fraction(sum(part["sum"] for part in parts), count << SUBNORMAL)) if count else math.nan
+    mean = exact_mean(sum(part["sum"] for part in parts), count)
     return {
         "count": count,
         "mean": mean,
@@ -260,11 +259,7 @@ def first_pass(item):
     start = max(first - before, 0)
     heights = tiled.read(slice(start, min(first + rows + after, ny)))
     own = heights[first - start : first - start + rows]
-    values = own[~np.isnan(own)]
-    part = {"count": values.size, "sum": exact_sum(values)}
-    part.update(
-        low=float(values.min()) if values.size else math.nan, high=float(values.max()) if values.size else math.nan
-    )
+    part = strip_extent(own[~np.isnan(own)])
     # the rows whose slopes are defined: 0 … ny - 2 (forward), 3 … ny - 4 (seven-point), a block at a time
     dx, dy = tiled.spacing
     sums = [(0, 0.0, 0.0)]

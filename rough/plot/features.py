@@ -11,7 +11,7 @@ from .surfaces import MapLayout, draw_map, draw_profile, facts_line
 
 @styled
 def features_figure(surface, features=(), density=None, material_ratio=None, title=None):
-    """A profile with its detected features shaded, or a map as :func:`~rough.plots.surface_figure`
+    """A profile with its detected features shaded, or a map as :func:`~rough.plot.surface_figure`
     draws it; given ``density``, the amplitude probability density of the heights
     with the Gaussian of the same Rq; given ``material_ratio``, beside it the
     Abbott–Firestone curve with the ISO 13565-2 construction (the 40 % central
@@ -67,15 +67,16 @@ def features_figure(surface, features=(), density=None, material_ratio=None, tit
         rectangles = [(MapLayout.LEFT + k * (half + 0.8), 0.55, half, density_height - 0.85) for k in (0, 1)]
         panels = [figure.add_axes(MapLayout._fraction(r, width, height)) for r in rectangles] if below else []
     if material_ratio is not None:
-        _draw_abbott(panels[1], material_ratio, "R" if surface.is_profile else "S")
+        draw_abbott(panels[1], material_ratio, "R" if surface.is_profile else "S")
     if panels and density is None:
         panels[0].remove()
     bottom = panels[0] if panels else None
     if density is not None:
-        centres, values = density
+        centres, values, outside = shown_density(heights, density)
         z_scale, z_unit = length_unit(float(centres[-1] - centres[0]) if len(centres) > 1 else 0.0)
         width = centres[1] - centres[0] if len(centres) > 1 else 1.0 / z_scale
-        bottom.bar(centres * z_scale, values / z_scale, width=width * z_scale, color="0.7", label="amplitude density")
+        label = "amplitude density" + (f" ({_tails(outside)} the range shown)" if any(outside) else "")
+        bottom.bar(centres * z_scale, values / z_scale, width=width * z_scale, color="0.7", label=label)
         rq = np.sqrt(np.nanmean(heights**2))
         grid = np.linspace(centres[0], centres[-1], 400)
         gaussian = np.exp(-0.5 * (grid / rq) ** 2) / (rq * np.sqrt(2 * np.pi))
@@ -95,8 +96,45 @@ def features_figure(surface, features=(), density=None, material_ratio=None, tit
     return figure
 
 
-def _draw_abbott(axes, curve, prefix):
-    """The material-ratio curve (height against %) with the ISO 13565-2 construction."""
+#: The quantiles (%) between which the amplitude density is drawn when outliers
+#: would squash it: a few deep pits or spikes beyond them are counted, not drawn.
+DENSITY_QUANTILES = (0.1, 99.9)
+
+
+def shown_density(heights, density):
+    """The amplitude density as drawn: ``density`` (``(centres, values)``) as it is,
+    unless heights beyond :data:`DENSITY_QUANTILES` stretch its range past that range
+    widened by half on each side (a Gaussian's range stays within it up to 10⁸
+    points); then the valid ``heights`` re-binned into as many bins over the
+    quantile range (normalised by all valid points, so that the bars still compare
+    with the Gaussian). Returns ``(centres, values, (below, above))``, the counts of
+    the valid points left out at each end."""
+    centres, values = (np.asarray(a, dtype=float) for a in density)
+    valid = heights[~np.isnan(heights)]
+    if valid.size < 2 or len(centres) < 2:
+        return centres, values, (0, 0)
+    low, high = np.percentile(valid, DENSITY_QUANTILES)
+    margin = (high - low) / 2
+    low, high = max(low - margin, valid.min()), min(high + margin, valid.max())
+    if valid.min() >= low and valid.max() <= high:
+        return centres, values, (0, 0)
+    counts, edges = np.histogram(valid, bins=len(centres), range=(low, high))
+    shown = counts / (valid.size * np.diff(edges))
+    return (edges[:-1] + edges[1:]) / 2, shown, (int(np.sum(valid < low)), int(np.sum(valid > high)))
+
+
+def _tails(outside):
+    """``(below, above)`` counts as words: "3 points below and 1 point above"."""
+    ends = zip(outside, ("below", "above"))
+    return " and ".join(f"{count} point{'s' if count != 1 else ''} {side}" for count, side in ends if count)
+
+
+def draw_abbott(axes, curve, prefix):
+    """Draw the material-ratio curve ``curve`` (a
+    :class:`~rough.metrology.MaterialRatioCurve`: height about the mean against
+    material ratio, %) on ``axes`` with the ISO 13565-2 construction: the 40 %
+    central region, the equivalent straight line, the core height ``prefix`` + k and
+    the triangles of ``prefix`` + pk and + vk (``prefix``: ``"R"`` or ``"S"``)."""
     core = curve.core()
     scale, unit = length_unit(float(curve.heights[0] - curve.heights[-1]))
     step = max(1, curve.heights.size // 4000)

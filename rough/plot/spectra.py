@@ -5,6 +5,7 @@ scale.
 
 import numpy as np
 
+from ..units import scale_for
 from .common import length_unit, pyplot, styled
 
 
@@ -17,8 +18,11 @@ def spectrum_figure(frequencies, density, fit, spacing, title="power spectrum"):
     plt = pyplot()
     frequencies, density = np.asarray(frequencies, dtype=float), np.asarray(density, dtype=float)
     figure, axes = plt.subplots(figsize=(7, 5))
-    axes.loglog(frequencies * 1e-3, density, "o", ms=3.5, color="0.35", label="binned periodogram")
     profile = fit.profile_dimension is None
+    (per_frequency, frequency_unit), (per_density, density_unit) = _axis_units(frequencies, density, profile)
+    axes.loglog(
+        frequencies * per_frequency, density * per_density, "o", ms=3.5, color="0.35", label="binned periodogram"
+    )
     if fit.fit_band is not None:
         low, high = fit.fit_band
         grid = np.geomspace(low, high, 200)
@@ -33,21 +37,43 @@ def spectrum_figure(frequencies, density, fit, spacing, title="power spectrum"):
             if fit.at_bound
             else f"{key} = {fit.fractal_dimension:.4f} ± {fit.fractal_dimension_stderr:.4f}"
         )
-        axes.loglog(grid * 1e-3, power + floor, color="tab:red", lw=2, label=f"model: {label}")
+        axes.loglog(grid * per_frequency, (power + floor) * per_density, color="tab:red", lw=2, label=f"model: {label}")
         if floor:
-            axes.loglog(grid * 1e-3, power, ":", color="tab:red", lw=1, label="power law alone")
-            axes.axhline(floor, xmin=0, xmax=1, color="tab:blue", lw=0.8, ls="--", label="noise floor")
-        axes.axvspan(low * 1e-3, high * 1e-3, color="tab:red", alpha=0.06, label=f"fit band, p = {fit.p_value:.2g}")
+            axes.loglog(grid * per_frequency, power * per_density, ":", color="tab:red", lw=1, label="power law alone")
+            axes.axhline(floor * per_density, xmin=0, xmax=1, color="tab:blue", lw=0.8, ls="--", label="noise floor")
+        axes.axvspan(
+            low * per_frequency,
+            high * per_frequency,
+            color="tab:red",
+            alpha=0.06,
+            label=f"fit band, p = {fit.p_value:.2g}",
+        )
         if fit.band and fit.band[1] < high:
-            axes.axvline(fit.band[1] * 1e-3, color="tab:blue", lw=0.8, label="noise crossover")
+            axes.axvline(fit.band[1] * per_frequency, color="tab:blue", lw=0.8, label="noise crossover")
         axes.set_title("power spectrum", fontsize=9, color="0.25")
     else:
         axes.set_title("power spectrum: no power-law range", fontsize=9, color="0.25")
-    axes.set_xlabel("spatial frequency (1/mm)")
-    axes.set_ylabel("PSD G(f) (m³)" if profile else "ring-averaged P2 (m⁴)")
+    axes.set_xlabel(f"spatial frequency ({frequency_unit})")
+    axes.set_ylabel(f"PSD G(f) ({density_unit})" if profile else f"ring-averaged P2 ({density_unit})")
     axes.legend()
     figure.suptitle(title)
     return figure
+
+
+def _axis_units(frequencies, density, profile):
+    """``((factor, label), (factor, label))`` for the frequency axis (per the length
+    that fits its highest frequency: ``/mm``) and the PSD axis: height² per frequency,
+    G in ``µm²·mm`` (P2 in ``µm²·mm²``), the height unit fitting the largest value."""
+    finite = np.isfinite(frequencies) & np.isfinite(density) & (frequencies > 0) & (density > 0)
+    top = float(frequencies[finite].max()) if finite.any() else 0.0
+    per_frequency, frequency_unit = scale_for(top, "1/m")
+    length = frequency_unit.lstrip("/") if top else "m"  # the length whose inverse the frequency is in
+    per_length = 1.0 / per_frequency if top else 1.0  # lengths in it per metre
+    power = 1 if profile else 2
+    largest = float(density[finite].max()) * per_length**power if finite.any() else 0.0
+    per_height, height_unit = length_unit(np.sqrt(largest))
+    superscript = "" if profile else "²"
+    return (per_frequency, frequency_unit), (per_height**2 * per_length**power, f"{height_unit}²·{length}{superscript}")
 
 
 @styled
@@ -62,7 +88,7 @@ def scale_dependent_figure(table, title="roughness against scale", cutoff=None):
     --------
     >>> import numpy as np
     >>> from rough.fractal.scales import scale_dependent
-    >>> from rough.plots import scale_dependent_figure
+    >>> from rough.plot import scale_dependent_figure
     >>> heights = np.cumsum(np.random.default_rng(0).standard_normal(1024)) * 1e-8
     >>> figure = scale_dependent_figure(scale_dependent(heights, 1e-6), "random walk")
     >>> [axes.get_ylabel() for axes in figure.axes]

@@ -14,6 +14,7 @@ import numpy as np
 from ..errors import InputError
 from ..extras import require
 from ..io.atomic import atomic_output
+from ..units import scale_for
 
 #: The rcParams of every rough figure: font sizes, a light grid, constrained layout
 #: (the successor of tight layout: it makes room for colour bars, legends and titles),
@@ -44,16 +45,6 @@ STYLE = {
 #: Formats :func:`save` writes (``--format`` of ``rough show``).
 FORMATS = ("png", "svg", "pdf")
 
-# (metres in one unit, units in one metre, symbol)
-_LENGTH_UNITS = [
-    (1e3, 1e-3, "km"),
-    (1.0, 1.0, "m"),
-    (1e-3, 1e3, "mm"),
-    (1e-6, 1e6, "µm"),
-    (1e-9, 1e9, "nm"),
-    (1e-12, 1e12, "pm"),
-]
-
 
 def pyplot():
     """matplotlib's pyplot on the Agg backend (no display needed), or
@@ -76,8 +67,8 @@ def style():
 
     Examples
     --------
-    >>> from rough import plots
-    >>> with plots.style():
+    >>> from rough import plot
+    >>> with plot.style():
     ...     import matplotlib.pyplot as plt
     ...     figure, axes = plt.subplots()
     >>> axes.xaxis.get_gridlines()[0].get_visible()
@@ -104,7 +95,7 @@ def save(figure, path, format=None, dpi=150):
     Parameters
     ----------
     figure : matplotlib.figure.Figure
-        The figure, e.g. from :func:`~rough.plots.surface_figure`.
+        The figure, e.g. from :func:`~rough.plot.surface_figure`.
     path : str or os.PathLike
         The file; ``-`` is standard output (refused when it is a terminal).
     format : str, optional
@@ -136,20 +127,16 @@ def save(figure, path, format=None, dpi=150):
 
 def length_unit(metres):
     """The unit (factor, symbol) in which a length of ``metres`` reads naturally, as
-    :func:`rough.units.format_length` chooses it: ``length_unit(6.4e-3)`` →
-    ``(1000.0, 'mm')``; 0 and NaN give metres.
+    :func:`rough.units.scale_for` chooses it for every printed length:
+    ``length_unit(6.4e-3)`` → ``(1000.0, 'mm')``; 0 and NaN give metres.
 
     Examples
     --------
-    >>> from rough.plots import length_unit
+    >>> from rough.plot import length_unit
     >>> length_unit(6.4e-3), length_unit(5e-4), length_unit(7.7e-8)
     ((1000.0, 'mm'), (1000000.0, 'µm'), (1000000000.0, 'nm'))
     """
-    magnitude = abs(float(metres))
-    if magnitude == 0 or not math.isfinite(magnitude):
-        return 1.0, "m"
-    _, per_metre, symbol = next((u for u in _LENGTH_UNITS if magnitude >= u[0] * 0.9999995), _LENGTH_UNITS[-1])
-    return per_metre, symbol
+    return scale_for(abs(float(metres)), "m")
 
 
 def nice_length(longest):

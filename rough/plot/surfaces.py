@@ -2,7 +2,7 @@
 panels that other figures share.
 
 Maps are drawn by one piece of code everywhere (:func:`surface_figure`, and the map
-panel of :func:`~rough.plots.features.features_figure`): heights in a perceptual
+panel of :func:`~rough.plot.features.features_figure`): heights in a perceptual
 colour map with a colour bar in a length unit chosen from the height range, axes in a
 length unit chosen from the extent, y upwards (row 0 at the bottom, so a georeferenced
 DEM is north up and angles counter-clockwise from +x, as ``rose`` and Std give them,
@@ -310,14 +310,14 @@ def surface_figure(surface, title=None, hillshade=False, note=None, colormap="vi
     Examples
     --------
     >>> import rough
-    >>> from rough import plots
+    >>> from rough import plot
     >>> scan = rough.read(rough.sample("rock-map.x3p"))
-    >>> figure = plots.surface_figure(scan, title="rock-map.x3p")
+    >>> figure = plot.surface_figure(scan, title="rock-map.x3p")
     >>> figure.get_suptitle()
     'rock-map.x3p'
     >>> figure.axes[0].get_xlabel(), figure.axes[1].get_ylabel()  # the map, its colour bar
     ('x (mm)', 'height (µm)')
-    >>> plots.save(figure, "rock-map.png")
+    >>> plot.save(figure, "rock-map.png")
     """
     plt = pyplot()
     title = title or surface.metadata.get("title") or "surface"

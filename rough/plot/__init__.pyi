@@ -1,4 +1,4 @@
-# The public names of rough.plots, loaded on first use by lazy_loader (see __init__.py).
+# The public names of rough.plot, loaded on first use by lazy_loader (see __init__.py).
 from .common import FORMATS as FORMATS
 from .common import STYLE as STYLE
 from .common import length_unit as length_unit
@@ -6,7 +6,13 @@ from .common import save as save
 from .common import style as style
 from .experiment import percentage_figure as percentage_figure
 from .experiment import proportion_interval as proportion_interval
+from .features import draw_abbott as draw_abbott
 from .features import features_figure as features_figure
+from .features import shown_density as shown_density
+from .figures import abbott as abbott
+from .figures import rose as rose
+from .figures import spectrum as spectrum
+from .figures import surface as surface
 from .haptics import force_figure as force_figure
 from .roses import rose_figure as rose_figure
 from .spectra import scale_dependent_figure as scale_dependent_figure
