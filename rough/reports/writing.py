@@ -54,9 +54,7 @@ def _check_folder(target):
 
 
 def _on_terminal(target):
-    if target == "-":
-        return sys.stdout is not None and sys.stdout.isatty()
-    return io.names_a_terminal(target)
+    return io.is_terminal(sys.stdout) if target == "-" else io.names_a_terminal(target)
 
 
 def settings_text(parameters=SETS, cutoff=None, ends="trim", order=None, fill=False, band=None):
